@@ -5,6 +5,7 @@ packages=(
   cmake g++ make pkg-config
   libmujoco-dev libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
+  libosmesa6-dev ffmpeg fonts-dejavu-core
 )
 missing=()
 for p in "${packages[@]}"; do
