@@ -1,0 +1,121 @@
+#include "metric/metric.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace diverse {
+
+Metric parse_metric(const std::string& name, const std::string& where) {
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower == "hf") return Metric::kHandsFeet;
+  if (lower == "md") return Metric::kMassDistance;
+  if (lower == "wja") return Metric::kWeightedJointAngles;
+  if (lower == "shape" || lower == "sd") return Metric::kShape;
+  throw_field_error(where, "", "unknown metric '" + name + "', expected one of hf, md, wja, shape");
+}
+
+const char* to_string(Metric metric) {
+  switch (metric) {
+    case Metric::kHandsFeet: return "hf";
+    case Metric::kMassDistance: return "md";
+    case Metric::kWeightedJointAngles: return "wja";
+    case Metric::kShape: return "shape";
+  }
+  return "?";
+}
+
+double angle_difference(double a, double b) {
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  double d = std::fmod(a - b, kTwoPi);
+  if (d > std::numbers::pi) d -= kTwoPi;
+  if (d <= -std::numbers::pi) d += kTwoPi;
+  return d;
+}
+
+Pose make_pose(const Eigen::Matrix3Xd& world_link_com, const Eigen::VectorXd& link_mass,
+               const Eigen::VectorXd& angles) {
+  if (world_link_com.cols() != link_mass.size())
+    throw std::logic_error("make_pose: one mass per link expected");
+  const double total = link_mass.sum();
+  if (!(total > 0.0)) throw std::logic_error("make_pose: total mass must be positive");
+  const Eigen::Vector3d com = world_link_com * link_mass / total;
+  return Pose{world_link_com.colwise() - com, link_mass, angles};
+}
+
+double pose_distance(Metric metric, const Pose& a, const Pose& b, const MetricLayout& layout) {
+  switch (metric) {
+    case Metric::kHandsFeet: {
+      double sum = 0.0;
+      for (int link : layout.hand_foot_links)
+        sum += (a.link_com.col(link) - b.link_com.col(link)).squaredNorm();
+      return sum;
+    }
+    case Metric::kMassDistance: {
+      if (a.link_com.cols() != b.link_com.cols())
+        throw std::logic_error("pose_distance: poses have different link counts");
+      // Link masses are equal for the same character; the mean keeps d symmetric if not.
+      const Eigen::VectorXd mass = 0.5 * (a.link_mass + b.link_mass);
+      return ((a.link_com - b.link_com).colwise().squaredNorm().transpose().array() *
+              mass.array())
+          .sum();
+    }
+    case Metric::kWeightedJointAngles: {
+      if (a.angles.size() != b.angles.size() ||
+          a.angles.size() != layout.angle_weights.size())
+        throw std::logic_error("pose_distance: angle vectors and weights differ in size");
+      double sum = 0.0;
+      for (Eigen::Index i = 0; i < a.angles.size(); ++i) {
+        const double d = angle_difference(a.angles[i], b.angles[i]);
+        sum += layout.angle_weights[i] * d * d;
+      }
+      return sum;
+    }
+    case Metric::kShape:
+      break;
+  }
+  throw std::logic_error("pose_distance: the shape metric does not compare poses");
+}
+
+double shape_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                      const Eigen::VectorXd& weights) {
+  if (a.size() != b.size())
+    throw std::logic_error("shape_distance: shapes have different link counts");
+  if (weights.size() == 0) return (a - b).cwiseAbs().sum();
+  if (weights.size() != a.size())
+    throw std::logic_error("shape_distance: weights do not match the link count");
+  return (weights.array() * (a - b).cwiseAbs().array()).sum();
+}
+
+double motion_distance(Metric metric, const MotionFeatures& a, const MotionFeatures& b,
+                       const MetricLayout& layout) {
+  if (metric == Metric::kShape)
+    return shape_distance(a.link_lengths, b.link_lengths, layout.shape_weights);
+  if (a.poses.empty() || b.poses.empty()) return 0.0;
+  if (a.poses.size() != b.poses.size())
+    throw std::logic_error("motion_distance: motions have different sample counts");
+  double sum = 0.0;
+  for (std::size_t k = 0; k < a.poses.size(); ++k)
+    sum += pose_distance(metric, a.poses[k], b.poses[k], layout);
+  return sum;
+}
+
+double lee2002_joint_weight(const std::string& joint_name) {
+  static constexpr const char* kWeighted[] = {"shoulder", "elbow", "hip",   "knee",
+                                              "pelvis",   "root",  "spine", "waist",
+                                              "abdomen",  "chest", "torso", "back"};
+  std::string lower = joint_name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* key : kWeighted)
+    if (lower.find(key) != std::string::npos) return 1.0;
+  return 0.0;
+}
+
+}  // namespace diverse
