@@ -1,0 +1,84 @@
+#include "io/files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+namespace diverse {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("diverse_files_test_" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+TEST(WriteFileAtomic, CreatesParentsAndLeavesNoTemporaries) {
+  const fs::path dir = scratch("atomic");
+  write_file_atomic(dir / "a" / "b.txt", "hello");
+  write_file_atomic(dir / "a" / "b.txt", "again");
+  EXPECT_EQ(read_file(dir / "a" / "b.txt"), "again");
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "a")) {
+    (void)entry;
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+}
+
+TEST(WriteJsonAtomic, DoublesRoundTripBitExactly) {
+  const fs::path dir = scratch("json");
+  Rng rng(99);
+  nlohmann::json values = nlohmann::json::array();
+  std::vector<double> originals;
+  for (int i = 0; i < 2000; ++i) {
+    const double x = (rng.uniform() - 0.5) * std::pow(10.0, static_cast<int>(rng.uniform() * 40) - 20);
+    originals.push_back(x);
+    values.push_back(x);
+  }
+  originals.push_back(std::numeric_limits<double>::denorm_min());
+  values.push_back(std::numeric_limits<double>::denorm_min());
+  write_json_atomic(dir / "v.json", values);
+  const nlohmann::json back = read_json(dir / "v.json");
+  ASSERT_EQ(back.size(), originals.size());
+  for (std::size_t i = 0; i < originals.size(); ++i)
+    EXPECT_EQ(back[i].get<double>(), originals[i]) << i;
+}
+
+TEST(ReadFile, MissingFileIsAOneLineUserError) {
+  try {
+    read_file("/nonexistent/dir/x.json");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/dir/x.json: cannot read (no such file)");
+  }
+}
+
+TEST(ReadJson, MalformedJsonNamesTheFile) {
+  const fs::path dir = scratch("bad");
+  write_file_atomic(dir / "bad.json", "{\"a\": [1, 2,");
+  try {
+    read_json(dir / "bad.json");
+    FAIL();
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind((dir / "bad.json").string() + ": not valid JSON (parse error", 0), 0u)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+  }
+}
+
+TEST(EnsureWritableDirectory, RefusesAPathThatIsAFile) {
+  const fs::path dir = scratch("notdir");
+  write_file_atomic(dir / "file", "x");
+  EXPECT_THROW(ensure_writable_directory(dir / "file"), UserError);
+  EXPECT_NO_THROW(ensure_writable_directory(dir / "sub" / "dir"));
+}
+
+}  // namespace
+}  // namespace diverse
