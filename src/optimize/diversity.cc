@@ -1,0 +1,525 @@
+#include "optimize/diversity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+namespace diverse {
+namespace {
+
+constexpr const char* kCheckpointFormat = "diverse.diversity_checkpoint";
+constexpr int kCheckpointVersion = 1;
+
+nlohmann::json vector_json(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+Eigen::VectorXd vector_from_json(const nlohmann::json& j) {
+  const auto values = j.get<std::vector<double>>();
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+nlohmann::json points_json(const std::vector<Eigen::VectorXd>& points) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& p : points) j.push_back(vector_json(p));
+  return j;
+}
+
+std::vector<Eigen::VectorXd> points_from_json(const nlohmann::json& j) {
+  std::vector<Eigen::VectorXd> points;
+  for (const auto& p : j) points.push_back(vector_from_json(p));
+  return points;
+}
+
+DiversityStop parse_stop(const std::string& name) {
+  for (DiversityStop s : {DiversityStop::kNone, DiversityStop::kMaxGenerations,
+                          DiversityStop::kStagnation, DiversityStop::kConverged}) {
+    if (name == to_string(s)) return s;
+  }
+  throw UserError("checkpoint: stop: expected a stop reason, got '" + name + "'");
+}
+
+std::shared_ptr<const Outcome> checked(std::shared_ptr<const Outcome> outcome) {
+  if (!outcome) throw std::logic_error("diversity: DiversityProblem::evaluate returned null");
+  return outcome;
+}
+
+// Evaluates several points on the pool, one outcome per point, in index order.
+std::vector<std::shared_ptr<const Outcome>> evaluate_all(const DiversityProblem& problem,
+                                                         ThreadPool& pool,
+                                                         const std::vector<Eigen::VectorXd>& xs) {
+  std::vector<std::shared_ptr<const Outcome>> outcomes(xs.size());
+  pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
+    outcomes[k] = checked(problem.evaluate(xs[k], worker));
+  });
+  return outcomes;
+}
+
+// D of `base` (the present motions, already scored) with motion `index` replaced by
+// `outcome`: only row and column `index` of the distance matrix change.
+double replaced_objective(const DiversityProblem& problem,
+                          const std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                          const DiversityScore& base, int index, const Outcome& outcome, double k) {
+  Eigen::MatrixXd distance = base.distance;
+  Eigen::VectorXd constraint = base.constraint;
+  constraint[index] = scored_constraint(outcome);
+  for (Eigen::Index j = 0; j < constraint.size(); ++j) {
+    if (j == index) continue;
+    // Arguments in index order, as score_diversity calls them.
+    const double d = j < index ? scored_distance(problem, *outcomes[j], outcome)
+                               : scored_distance(problem, outcome, *outcomes[j]);
+    distance(index, j) = d;
+    distance(j, index) = d;
+  }
+  return diversity_objective(distance, constraint, k);
+}
+
+}  // namespace
+
+const char* to_string(DiversityStrategy strategy) {
+  switch (strategy) {
+    case DiversityStrategy::kRoundRobin: return "round-robin";
+    case DiversityStrategy::kProgressive: return "progressive";
+    case DiversityStrategy::kJoint: return "joint";
+  }
+  return "?";
+}
+
+DiversityStrategy parse_strategy(const std::string& name, const std::string& where) {
+  for (DiversityStrategy s : {DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive,
+                              DiversityStrategy::kJoint}) {
+    if (name == to_string(s)) return s;
+  }
+  throw UserError(where + ": expected one of round-robin, progressive, joint, got '" + name + "'");
+}
+
+const char* to_string(DiversityStop stop) {
+  switch (stop) {
+    case DiversityStop::kNone: return "none";
+    case DiversityStop::kMaxGenerations: return "max-generations";
+    case DiversityStop::kStagnation: return "stagnation";
+    case DiversityStop::kConverged: return "converged";
+  }
+  return "?";
+}
+
+void validate(const DiversityOptions& o) {
+  auto fail = [](const std::string& what) {
+    throw std::invalid_argument("diversity options: " + what);
+  };
+  if (o.variations < 1) fail("variations must be >= 1");
+  if (!(o.k >= 0.0) || !std::isfinite(o.k)) fail("k must be a finite number >= 0");
+  if (o.popsize < 2) fail("popsize must be >= 2");
+  if (!(o.sigma0 > 0.0) || !std::isfinite(o.sigma0)) fail("sigma0 must be > 0");
+  if (o.max_generations < 1) fail("max_generations must be >= 1");
+  if (o.window < 0) fail("window must be >= 0");
+  if (!(o.epsilon >= 0.0)) fail("epsilon must be >= 0");
+}
+
+nlohmann::json to_json(const DiversityOptions& o) {
+  return {{"variations", o.variations},         {"k", o.k},
+          {"strategy", to_string(o.strategy)},  {"popsize", o.popsize},
+          {"sigma0", o.sigma0},                 {"max_generations", o.max_generations},
+          {"window", o.window},                 {"epsilon", o.epsilon},
+          {"seed", o.seed}};
+}
+
+DiversityOptions diversity_options_from_json(const nlohmann::json& j) {
+  DiversityOptions o;
+  o.variations = j.at("variations").get<int>();
+  o.k = j.at("k").get<double>();
+  o.strategy = parse_strategy(j.at("strategy").get<std::string>(), "strategy");
+  o.popsize = j.at("popsize").get<int>();
+  o.sigma0 = j.at("sigma0").get<double>();
+  o.max_generations = j.at("max_generations").get<long long>();
+  o.window = j.at("window").get<int>();
+  o.epsilon = j.at("epsilon").get<double>();
+  o.seed = j.at("seed").get<std::uint64_t>();
+  return o;
+}
+
+nlohmann::json to_json(const DiversityRecord& r) {
+  return {{"generation", r.generation}, {"step", r.step},
+          {"variation", r.variation},   {"D", r.D},
+          {"best_D", r.best_D},         {"constraint", vector_json(r.constraint)},
+          {"dmin", vector_json(r.dmin)}, {"evaluations", r.evaluations}};
+}
+
+namespace {
+
+DiversityRecord record_from_json(const nlohmann::json& j) {
+  DiversityRecord r;
+  r.generation = j.at("generation").get<long long>();
+  r.step = j.at("step").get<long long>();
+  r.variation = j.at("variation").get<int>();
+  r.D = j.at("D").get<double>();
+  r.best_D = j.at("best_D").get<double>();
+  r.constraint = vector_from_json(j.at("constraint"));
+  r.dmin = vector_from_json(j.at("dmin"));
+  r.evaluations = j.at("evaluations").get<long long>();
+  return r;
+}
+
+}  // namespace
+
+DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool)
+    : problem_(&problem), pool_(&pool) {}
+
+DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
+                                       const DiversityOptions& options, ThreadPool& pool)
+    : problem_(&problem), pool_(&pool), options_(options) {
+  validate(options_);
+  const int n = options_.variations;
+  const int dim = problem_->dim();
+  const Eigen::VectorXd p0 = problem_->reference();
+  if (dim < 1 || p0.size() != dim) {
+    throw std::logic_error("diversity: problem reference must have dim() >= 1 entries");
+  }
+
+  // Every variation starts at P_0, so all share M_0's outcome until they move.
+  const auto m0 = evaluate_all(*problem_, *pool_, {p0}).front();
+  evaluations_ = 1;
+  points_.assign(n + 1, p0);
+  outcomes_.assign(n + 1, m0);
+  paths_.assign(n + 1, {PathPoint{0, 0, p0}});
+
+  if (options_.strategy == DiversityStrategy::kJoint) {
+    cmas_.emplace_back(cma_options(n * dim, 0), p0.replicate(n, 1));
+  } else {
+    for (int v = 1; v <= n; ++v) cmas_.emplace_back(cma_options(dim, v), p0);
+  }
+  if (options_.strategy == DiversityStrategy::kProgressive) {
+    active_ = 1;
+    phase_start_ = 0;
+    phase_budget_ = std::max<long long>(1, options_.max_generations / n);
+  }
+  rescore();
+  best_ = Snapshot{points_, outcomes_, current_};
+  best_history_.push_back(best_.score.D);
+}
+
+CmaesOptions DiversityOptimizer::cma_options(int dim, int instance) const {
+  CmaesOptions o;
+  o.dim = dim;
+  o.popsize = options_.popsize;
+  o.sigma0 = options_.sigma0;
+  o.seed = derive_seed(options_.seed, {static_cast<std::uint64_t>(instance)});
+  o.bounded = true;  // normalized parameters: reflection into [0, 1]
+  o.lower = 0.0;
+  o.upper = 1.0;
+  // D moves as the other variations move, so "f stopped changing" and "x stopped moving"
+  // say little about one instance; the optimizer's own stagnation test decides instead.
+  o.tol_fun = 0.0;
+  o.tol_x = 0.0;
+  return o;
+}
+
+int DiversityOptimizer::present() const {
+  return options_.strategy == DiversityStrategy::kProgressive ? active_ + 1
+                                                              : options_.variations + 1;
+}
+
+void DiversityOptimizer::rescore() {
+  const std::vector<std::shared_ptr<const Outcome>> present_outcomes(
+      outcomes_.begin(), outcomes_.begin() + present());
+  current_ = score_diversity(*problem_, present_outcomes, options_.k);
+}
+
+bool DiversityOptimizer::step() {
+  if (done()) return false;
+  ++generation_;
+  switch (options_.strategy) {
+    case DiversityStrategy::kRoundRobin:
+      for (int v = 1; v <= options_.variations; ++v) {
+        if (cmas_[v - 1].stop_reason() == StopReason::kNone) step_variation(v);
+      }
+      break;
+    case DiversityStrategy::kProgressive:
+      for (int s = 0; s < options_.variations; ++s) {
+        if (cmas_[active_ - 1].stop_reason() != StopReason::kNone) break;
+        step_variation(active_);
+      }
+      break;
+    case DiversityStrategy::kJoint:
+      step_joint();
+      break;
+  }
+  end_generation();
+  return !done();
+}
+
+void DiversityOptimizer::run() {
+  while (step()) {
+  }
+}
+
+void DiversityOptimizer::step_variation(int v) {
+  Cmaes& es = cmas_[v - 1];
+  const std::vector<Eigen::VectorXd> xs = es.ask();
+  std::vector<double> fitness(xs.size());
+  // Each sample replaces M_v in the current set; CMA minimizes, so it is told -D.
+  pool_->parallel_for(xs.size(), [&](std::size_t k, int worker) {
+    const auto outcome = checked(problem_->evaluate(xs[k], worker));
+    fitness[k] = -replaced_objective(*problem_, outcomes_, current_, v, *outcome, options_.k);
+  });
+  evaluations_ += static_cast<long long>(xs.size());
+  es.tell(fitness);
+
+  // The new mean is what the other variations' samples are scored against from now on.
+  points_[v] = es.mean();
+  outcomes_[v] = evaluate_all(*problem_, *pool_, {points_[v]}).front();
+  evaluations_ += 1;
+  finish_step(v);
+}
+
+void DiversityOptimizer::step_joint() {
+  Cmaes& es = cmas_.front();
+  const int n = options_.variations;
+  const int dim = problem_->dim();
+  const std::vector<Eigen::VectorXd> xs = es.ask();
+  const std::size_t lambda = xs.size();
+
+  // Every sample is a whole set M_1..M_N: N evaluations each, all independent.
+  std::vector<std::shared_ptr<const Outcome>> outcomes(lambda * n);
+  pool_->parallel_for(lambda * n, [&](std::size_t index, int worker) {
+    const std::size_t k = index / n;
+    const int v = static_cast<int>(index % n);
+    outcomes[index] = checked(problem_->evaluate(xs[k].segment(v * dim, dim), worker));
+  });
+  evaluations_ += static_cast<long long>(lambda * n);
+  std::vector<double> fitness(lambda);
+  pool_->parallel_for(lambda, [&](std::size_t k, int) {
+    std::vector<std::shared_ptr<const Outcome>> set{outcomes_.front()};
+    set.insert(set.end(), outcomes.begin() + k * n, outcomes.begin() + (k + 1) * n);
+    fitness[k] = -score_diversity(*problem_, set, options_.k).D;
+  });
+  es.tell(fitness);
+
+  const Eigen::VectorXd mean = es.mean();
+  std::vector<Eigen::VectorXd> means;
+  for (int v = 1; v <= n; ++v) means.push_back(mean.segment((v - 1) * dim, dim));
+  const auto mean_outcomes = evaluate_all(*problem_, *pool_, means);
+  evaluations_ += n;
+  for (int v = 1; v <= n; ++v) {
+    points_[v] = means[v - 1];
+    outcomes_[v] = mean_outcomes[v - 1];
+  }
+  finish_step(0);
+}
+
+void DiversityOptimizer::finish_step(int variation) {
+  ++steps_;
+  rescore();
+  if (current_.D > best_.score.D) best_ = Snapshot{points_, outcomes_, current_};
+
+  DiversityRecord record;
+  record.generation = generation_;
+  record.step = steps_;
+  record.variation = variation;
+  record.D = current_.D;
+  record.best_D = best_.score.D;
+  record.constraint = current_.constraint;
+  record.dmin = current_.dmin;
+  record.evaluations = evaluations_;
+  log_.push_back(record);
+
+  if (variation > 0) {
+    paths_[variation].push_back(PathPoint{generation_, steps_, points_[variation]});
+  } else {
+    for (int v = 1; v <= options_.variations; ++v) {
+      paths_[v].push_back(PathPoint{generation_, steps_, points_[v]});
+    }
+  }
+  if (callback_) callback_(record);
+}
+
+void DiversityOptimizer::end_generation() {
+  best_history_.push_back(best_.score.D);
+  const int window = options_.window;
+  auto stagnated = [&](long long since) {
+    return window > 0 && generation_ - since >= window &&
+           best_.score.D - best_history_[generation_ - window] < options_.epsilon;
+  };
+
+  if (options_.strategy != DiversityStrategy::kProgressive) {
+    const bool all_stopped = std::all_of(cmas_.begin(), cmas_.end(), [](const Cmaes& es) {
+      return es.stop_reason() != StopReason::kNone;
+    });
+    if (generation_ >= options_.max_generations) {
+      stop_ = DiversityStop::kMaxGenerations;
+    } else if (stagnated(0)) {
+      stop_ = DiversityStop::kStagnation;
+    } else if (all_stopped) {
+      stop_ = DiversityStop::kConverged;
+    }
+    return;
+  }
+
+  // Progressive: does the newest variation's phase end here?
+  DiversityStop phase_end = DiversityStop::kNone;
+  if (generation_ - phase_start_ >= phase_budget_) {
+    phase_end = DiversityStop::kMaxGenerations;
+  } else if (stagnated(phase_start_)) {
+    phase_end = DiversityStop::kStagnation;
+  } else if (cmas_[active_ - 1].stop_reason() != StopReason::kNone) {
+    phase_end = DiversityStop::kConverged;
+  }
+  if (phase_end == DiversityStop::kNone) return;
+
+  // Freeze the newest variation where the phase's best set had it.
+  points_ = best_.points;
+  outcomes_ = best_.outcomes;
+  current_ = best_.score;
+  if (active_ == options_.variations) {
+    stop_ = phase_end;
+    return;
+  }
+  ++active_;
+  phase_start_ = generation_;
+  const long long left = options_.max_generations - generation_;
+  phase_budget_ = std::max<long long>(1, left / (options_.variations - active_ + 1));
+  rescore();
+  best_ = Snapshot{points_, outcomes_, current_};
+  best_history_.back() = best_.score.D;
+}
+
+DiversityResult DiversityOptimizer::result() const {
+  DiversityResult r;
+  const int count = present();
+  r.parameters.assign(best_.points.begin(), best_.points.begin() + count);
+  r.outcomes.assign(best_.outcomes.begin(), best_.outcomes.begin() + count);
+  r.score = best_.score;
+  r.generations = generation_;
+  r.evaluations = evaluations_;
+  r.stop = stop_;
+  return r;
+}
+
+nlohmann::json DiversityOptimizer::checkpoint() const {
+  nlohmann::json j;
+  j["format"] = kCheckpointFormat;
+  j["version"] = kCheckpointVersion;
+  j["options"] = to_json(options_);
+  j["reference"] = vector_json(points_.front());
+  j["generation"] = generation_;
+  j["steps"] = steps_;
+  j["evaluations"] = evaluations_;
+  j["stop"] = to_string(stop_);
+  j["active"] = active_;
+  j["phase_start"] = phase_start_;
+  j["phase_budget"] = phase_budget_;
+  nlohmann::json cmas = nlohmann::json::array();
+  for (const auto& es : cmas_) cmas.push_back(es.to_json());
+  j["cma"] = std::move(cmas);
+  j["points"] = points_json(points_);
+  j["current_D"] = current_.D;
+  j["best"] = {{"points", points_json(best_.points)}, {"D", best_.score.D}};
+  j["best_history"] = best_history_;
+  nlohmann::json log = nlohmann::json::array();
+  for (const auto& r : log_) log.push_back(to_json(r));
+  j["log"] = std::move(log);
+  nlohmann::json paths = nlohmann::json::array();
+  for (const auto& path : paths_) {
+    nlohmann::json p = nlohmann::json::array();
+    for (const auto& point : path) {
+      p.push_back({{"generation", point.generation}, {"step", point.step},
+                   {"x", vector_json(point.x)}});
+    }
+    paths.push_back(std::move(p));
+  }
+  j["paths"] = std::move(paths);
+  return j;
+}
+
+DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& problem,
+                                                       const nlohmann::json& j,
+                                                       ThreadPool& pool) {
+  if (!j.is_object() || j.value("format", std::string()) != kCheckpointFormat) {
+    throw UserError(std::string("checkpoint: format: expected \"") + kCheckpointFormat + "\"");
+  }
+  if (j.value("version", 0) != kCheckpointVersion) {
+    throw UserError("checkpoint: version: expected " + std::to_string(kCheckpointVersion));
+  }
+  DiversityOptimizer opt(problem, pool);
+  try {
+    opt.options_ = diversity_options_from_json(j.at("options"));
+    validate(opt.options_);
+    const Eigen::VectorXd reference = vector_from_json(j.at("reference"));
+    if (reference.size() != problem.dim()) {
+      throw UserError("checkpoint: reference: expected " + std::to_string(problem.dim()) +
+                      " parameters, got " + std::to_string(reference.size()));
+    }
+    if (reference != problem.reference()) {
+      throw UserError("checkpoint: reference: expected the problem's reference parameters");
+    }
+    opt.generation_ = j.at("generation").get<long long>();
+    opt.steps_ = j.at("steps").get<long long>();
+    opt.evaluations_ = j.at("evaluations").get<long long>();
+    opt.stop_ = parse_stop(j.at("stop").get<std::string>());
+    opt.active_ = j.at("active").get<int>();
+    opt.phase_start_ = j.at("phase_start").get<long long>();
+    opt.phase_budget_ = j.at("phase_budget").get<long long>();
+    for (const auto& state : j.at("cma")) opt.cmas_.push_back(Cmaes::from_json(state));
+    opt.points_ = points_from_json(j.at("points"));
+    opt.best_.points = points_from_json(j.at("best").at("points"));
+    opt.best_history_ = j.at("best_history").get<std::vector<double>>();
+    for (const auto& r : j.at("log")) opt.log_.push_back(record_from_json(r));
+    for (const auto& path : j.at("paths")) {
+      std::vector<PathPoint> p;
+      for (const auto& point : path) {
+        p.push_back(PathPoint{point.at("generation").get<long long>(),
+                              point.at("step").get<long long>(), vector_from_json(point.at("x"))});
+      }
+      opt.paths_.push_back(std::move(p));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(std::string("checkpoint: ") + e.what());
+  }
+  const std::size_t count = static_cast<std::size_t>(opt.options_.variations) + 1;
+  const std::size_t instances =
+      opt.options_.strategy == DiversityStrategy::kJoint ? 1 : count - 1;
+  if (opt.points_.size() != count || opt.best_.points.size() != count ||
+      opt.cmas_.size() != instances || opt.paths_.size() != count ||
+      static_cast<long long>(opt.best_history_.size()) != opt.generation_ + 1) {
+    throw UserError("checkpoint: expected state for " + std::to_string(count - 1) +
+                    " variations at generation " + std::to_string(opt.generation_));
+  }
+  for (const auto& p : opt.points_) {
+    if (p.size() != problem.dim()) throw UserError("checkpoint: points: wrong dimension");
+  }
+
+  // Outcomes are not stored: evaluate the distinct points of the current and best sets
+  // again (evaluate() is a pure function of x, so these are the same outcomes).
+  std::vector<Eigen::VectorXd> distinct;
+  auto index_of = [&](const Eigen::VectorXd& x) {
+    for (std::size_t i = 0; i < distinct.size(); ++i) {
+      if (distinct[i] == x) return i;
+    }
+    distinct.push_back(x);
+    return distinct.size() - 1;
+  };
+  std::vector<std::size_t> current_index, best_index;
+  for (const auto& p : opt.points_) current_index.push_back(index_of(p));
+  for (const auto& p : opt.best_.points) best_index.push_back(index_of(p));
+  const auto outcomes = evaluate_all(problem, pool, distinct);
+  for (std::size_t i : current_index) opt.outcomes_.push_back(outcomes[i]);
+  for (std::size_t i : best_index) opt.best_.outcomes.push_back(outcomes[i]);
+
+  opt.rescore();
+  const std::vector<std::shared_ptr<const Outcome>> best_present(
+      opt.best_.outcomes.begin(), opt.best_.outcomes.begin() + opt.present());
+  opt.best_.score = score_diversity(problem, best_present, opt.options_.k);
+  if (opt.current_.D != j.at("current_D").get<double>() ||
+      opt.best_.score.D != j.at("best").at("D").get<double>()) {
+    throw std::logic_error(
+        "checkpoint: re-evaluated sets do not reproduce their recorded D "
+        "(DiversityProblem::evaluate is not deterministic, or the problem changed)");
+  }
+  return opt;
+}
+
+}  // namespace diverse

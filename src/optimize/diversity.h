@@ -1,0 +1,204 @@
+// Diversity optimization: finds N variations M_1..M_N of a reference M_0 that maximize
+// the diversity objective D (paper eq. 1, see optimize/objective.h), with CMA-ES.
+//
+// Agrawal, Shen, van de Panne, "Diverse Motions and Character Shapes for Simulated
+// Skills", IEEE TVCG 2014, section 3. Three strategies:
+//
+//   round-robin  (the paper's method, default) N CMA-ES instances, one per variation,
+//                all starting at P_0. Variation i gets one CMA generation of lambda
+//                samples while the others stay at their current means; each sample is
+//                scored by the full D with M_i replaced by the sample (CMA minimizes
+//                -D); then variation i+1, and so on.
+//   progressive  (baseline, paper section 9) variations are added one at a time; only
+//                the newest is optimized, against M_0 and the earlier ones, until it stops
+//                improving or its share of the generation budget ends; it is then frozen
+//                at the best set found in its phase.
+//   joint        (baseline) one CMA-ES instance over all N x |P| parameters; a sample is
+//                a whole set M_1..M_N.
+//
+// Generations. One generation costs N x lambda evaluations in every strategy, so budgets
+// compare directly:
+//   round-robin  one CMA generation of each variation, in order 1..N;
+//   progressive  N CMA generations of the newest variation;
+//   joint        one CMA generation (lambda samples, each N evaluations) of the joint
+//                instance.
+// A "step" is one CMA generation of one instance; the log has one record per step.
+// On top of the sample evaluations, the mean of every instance that moved is evaluated
+// again (one evaluation per variation per step): its outcome is what the other variations'
+// samples are scored against. `evaluations` counts both.
+//
+// Termination, checked at the end of each generation: the generation limit; stagnation
+// (the best D improved by less than epsilon over the last `window` generations); or every
+// CMA instance stopped on its own numerical criteria (condition number, no-effect axis;
+// its TolFun / TolX are disabled because D moves under it as the other variations move).
+// Progressive: each phase ends on stagnation within the phase or when its share of the
+// budget, (max_generations - generations used) / (variations still to add), at least 1,
+// is used up; the run ends when the last variation's phase ends.
+//
+// The result is the best set seen: after every step the current set (P_0 and every
+// variation's current mean) is scored, and the one with the highest D is kept.
+//
+// Determinism. CMA instance v (1..N; 0 for joint) draws from derive_seed(seed, {v}); a
+// generation's samples are drawn before any is evaluated, evaluated in parallel on the
+// thread pool, and written by index, so results are bit-identical for any thread count.
+// checkpoint() captures everything at a generation boundary (CMA states, counters,
+// strategy state, best set, log and paths); a restored optimizer re-evaluates the
+// outcomes of its current and best sets (not counted as evaluations) and then continues
+// exactly as the uninterrupted run would.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "optimize/cmaes.h"
+#include "optimize/objective.h"
+
+namespace diverse {
+
+enum class DiversityStrategy { kRoundRobin, kProgressive, kJoint };
+// "round-robin", "progressive", "joint".
+const char* to_string(DiversityStrategy strategy);
+// Parses the names above; throws UserError "WHERE: expected one of round-robin,
+// progressive, joint, got 'NAME'".
+DiversityStrategy parse_strategy(const std::string& name, const std::string& where = "--strategy");
+
+struct DiversityOptions {
+  int variations = 4;               // N >= 1, variations besides M_0
+  double k = 10.0;                  // K >= 0, weight of the dmin term (paper: 10)
+  DiversityStrategy strategy = DiversityStrategy::kRoundRobin;
+  int popsize = 16;                 // lambda >= 2, samples per CMA generation (paper: 16)
+  double sigma0 = 0.1;              // > 0, initial CMA step size, normalized units
+  long long max_generations = 500;  // >= 1, generation limit (paper: 500-1000)
+  int window = 50;                  // >= 0, stagnation window in generations; 0 = off
+  double epsilon = 1e-6;            // >= 0, least improvement of the best D over window
+  std::uint64_t seed = 1;           // run seed; every stream derives from it
+};
+// Throws std::invalid_argument naming the first field out of range.
+void validate(const DiversityOptions& options);
+nlohmann::json to_json(const DiversityOptions& options);
+DiversityOptions diversity_options_from_json(const nlohmann::json& j);
+
+// One log record per step (one CMA generation of one instance).
+struct DiversityRecord {
+  long long generation = 0;    // 1-based generation the step belongs to
+  long long step = 0;          // 1-based count of steps over all instances
+  int variation = 0;           // variation optimized, 1..N; 0 = all (joint)
+  double D = 0.0;              // D of the current set after the step
+  double best_D = 0.0;         // highest D of any set so far (in this phase for progressive)
+  Eigen::VectorXd constraint;  // C(M_i) of the current set, i = 0..(motions present - 1)
+  Eigen::VectorXd dmin;        // dmin(M_i) of the current set, same indexing
+  long long evaluations = 0;   // evaluations so far, including this step's
+};
+nlohmann::json to_json(const DiversityRecord& record);
+
+// A point of a variation's optimization path: its CMA mean after one of its steps.
+struct PathPoint {
+  long long generation = 0;  // 0 for the start at P_0
+  long long step = 0;
+  Eigen::VectorXd x;         // normalized parameters
+};
+
+enum class DiversityStop { kNone, kMaxGenerations, kStagnation, kConverged };
+// "none", "max-generations", "stagnation", "converged".
+const char* to_string(DiversityStop stop);
+
+struct DiversityResult {
+  std::vector<Eigen::VectorXd> parameters;                // P_0..P_N, normalized
+  std::vector<std::shared_ptr<const Outcome>> outcomes;   // M_0..M_N
+  DiversityScore score;                                   // D, distances, C, dmin
+  long long generations = 0;
+  long long evaluations = 0;
+  DiversityStop stop = DiversityStop::kNone;
+};
+
+class DiversityOptimizer {
+ public:
+  using Callback = std::function<void(const DiversityRecord&)>;
+
+  // Evaluates P_0 once. The problem and pool must outlive the optimizer; the pool's size
+  // is the number of workers the problem was prepared for.
+  DiversityOptimizer(const DiversityProblem& problem, const DiversityOptions& options,
+                     ThreadPool& pool);
+  // Restores from checkpoint(). Throws UserError if the checkpoint does not fit the
+  // problem (dimension or reference differ) and std::logic_error if re-evaluating the
+  // stored sets does not reproduce their recorded D (evaluate() is not deterministic).
+  static DiversityOptimizer from_checkpoint(const DiversityProblem& problem,
+                                            const nlohmann::json& checkpoint, ThreadPool& pool);
+
+  // Called after every step with its log record (also kept in log()).
+  void set_callback(Callback callback) { callback_ = std::move(callback); }
+
+  // Runs one generation unless done; returns !done() afterwards.
+  bool step();
+  // Runs generations until done.
+  void run();
+
+  bool done() const { return stop_ != DiversityStop::kNone; }
+  DiversityStop stop_reason() const { return stop_; }
+  long long generation() const { return generation_; }
+  long long evaluations() const { return evaluations_; }
+  const DiversityOptions& options() const { return options_; }
+
+  const std::vector<DiversityRecord>& log() const { return log_; }
+  // paths()[v] for v = 1..N (paths()[0] holds P_0 alone).
+  const std::vector<std::vector<PathPoint>>& paths() const { return paths_; }
+  // The current set (P_0 and the variations' current means) and its score. Progressive:
+  // only the motions added so far.
+  const std::vector<Eigen::VectorXd>& current_parameters() const { return points_; }
+  const DiversityScore& current_score() const { return current_; }
+
+  // The best set so far (see the header comment).
+  DiversityResult result() const;
+
+  // The complete state; call between step()s.
+  nlohmann::json checkpoint() const;
+
+ private:
+  struct Snapshot {
+    std::vector<Eigen::VectorXd> points;
+    std::vector<std::shared_ptr<const Outcome>> outcomes;
+    DiversityScore score;
+  };
+
+  DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool);
+  CmaesOptions cma_options(int dim, int instance) const;
+  int present() const;  // motions in the current set, M_0 included
+  void step_variation(int variation);
+  void step_joint();
+  void rescore();
+  void finish_step(int variation);
+  void end_generation();
+  void start_phase();
+
+  const DiversityProblem* problem_;
+  ThreadPool* pool_;
+  DiversityOptions options_;
+  Callback callback_;
+
+  std::vector<Cmaes> cmas_;  // N instances (index v - 1), or one (joint)
+  std::vector<Eigen::VectorXd> points_;                  // current set, N + 1 entries
+  std::vector<std::shared_ptr<const Outcome>> outcomes_;  // their outcomes
+  DiversityScore current_;                               // score of the present motions
+  Snapshot best_;
+  std::vector<double> best_history_;  // best D at the end of each generation (0 = start)
+
+  long long generation_ = 0;
+  long long steps_ = 0;
+  long long evaluations_ = 0;
+  DiversityStop stop_ = DiversityStop::kNone;
+  // Progressive: the variation being optimized, when its phase began, and its budget.
+  int active_ = 0;
+  long long phase_start_ = 0;
+  long long phase_budget_ = 0;
+
+  std::vector<DiversityRecord> log_;
+  std::vector<std::vector<PathPoint>> paths_;
+};
+
+}  // namespace diverse

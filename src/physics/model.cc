@@ -1,0 +1,103 @@
+#include "physics/model.h"
+
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+#include "core/error.h"
+#include "physics/mujoco_guard.h"
+
+namespace diverse {
+namespace {
+
+// mj_loadXML and mj_saveLastXML share process-global parser state.
+std::mutex& loader_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+// Compiles `xml` through a virtual file system (heap-allocated: mjVFS is large).
+// Caller holds the loader lock.
+mjModel* compile_locked(const std::string& xml, std::string* error) {
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const char* name = "diverse_model.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0) {
+    *error = "cannot allocate the model text in MuJoCo's virtual file system";
+    return nullptr;
+  }
+  const int index = mj_findFileVFS(vfs.get(), name);
+  std::memcpy(vfs->filedata[index], xml.data(), xml.size());
+  char message[1000] = "";
+  mjModel* model = mj_loadXML(name, vfs.get(), message, sizeof(message));
+  mj_deleteVFS(vfs.get());
+  if (model == nullptr) *error = message;
+  return model;
+}
+
+}  // namespace
+
+std::shared_ptr<const SharedModel> SharedModel::from_xml(const std::string& xml,
+                                                         const std::string& origin) {
+  install_mujoco_handlers();
+  std::string error;
+  mjModel* model = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(loader_mutex());
+    model = compile_locked(xml, &error);
+  }
+  if (model == nullptr) {
+    for (char& c : error) {
+      if (c == '\n') c = ' ';
+    }
+    throw UserError(origin + ": MuJoCo cannot compile the model: " + error);
+  }
+  std::shared_ptr<SharedModel> shared(new SharedModel());
+  shared->model_ = model;
+  shared->xml_ = xml;
+  shared->origin_ = origin;
+  return shared;
+}
+
+std::shared_ptr<const SharedModel> SharedModel::from_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UserError(path + ": cannot read the model file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return from_xml(text.str(), path);
+}
+
+SharedModel::~SharedModel() {
+  if (model_ != nullptr) mj_deleteModel(model_);
+}
+
+void SharedModel::save_xml(const std::string& path) const {
+  std::lock_guard<std::mutex> lock(loader_mutex());
+  std::string error;
+  mjModel* model = compile_locked(xml_, &error);
+  if (model == nullptr) throw UserError(origin_ + ": MuJoCo cannot compile the model: " + error);
+  char message[1000] = "";
+  const int ok = mj_saveLastXML(path.c_str(), model, message, sizeof(message));
+  mj_deleteModel(model);
+  if (!ok) throw UserError(path + ": MuJoCo cannot save the model: " + message);
+}
+
+SimWorker::SimWorker(std::shared_ptr<const SharedModel> shared) : shared_(std::move(shared)) {
+  model_ = mj_copyModel(nullptr, shared_->get());
+  data_ = mj_makeData(model_);
+}
+
+SimWorker::~SimWorker() {
+  if (data_ != nullptr) mj_deleteData(data_);
+  if (model_ != nullptr) mj_deleteModel(model_);
+}
+
+void SimWorker::reset() {
+  const mjModel* src = shared_->get();
+  std::memcpy(model_->dof_damping, src->dof_damping, sizeof(mjtNum) * src->nv);
+  mj_resetData(model_, data_);
+}
+
+}  // namespace diverse

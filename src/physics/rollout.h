@@ -1,0 +1,69 @@
+// The rollout loop: control, observe, step, until the outcome is decided.
+//
+// Each step runs mj_step1 (kinematics, contacts and velocities of the current state),
+// then the hooks' control() writes d->ctrl (and the worker's dof_damping), observe()
+// decides whether to stop, and mj_step2 integrates. mj_step1 + mj_step2 computes exactly
+// what mj_step does with the same inputs, so a recorded rollout replays bit for bit with
+// plain mj_step (see replay()).
+//
+// A rollout that goes unstable (a MuJoCo warning, a non-finite state, or a MuJoCo error
+// caught by the guard) stops and reports it; it never throws or aborts.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
+
+#include "physics/model.h"
+
+namespace diverse {
+
+class StepHooks {
+ public:
+  virtual ~StepHooks() = default;
+  // Called after mj_step1: writes d->ctrl and may write m->dof_damping.
+  virtual void control(mjModel* m, mjData* d) = 0;
+  // Called after control(), before integration. Return true to stop before this step.
+  virtual bool observe(const mjModel* m, const mjData* d) = 0;
+};
+
+// Everything needed to replay a rollout exactly, and what to check it with.
+// Kept only when a StepRecorder is passed; off in the optimizer's hot path.
+struct StepRecorder {
+  int nq = 0, nu = 0, ndamp = 0;
+  double timestep = 0;                // s
+  std::vector<double> qpos0, qvel0;   // initial state
+  std::vector<int> damped_dofs;       // dof indices whose damping the controller writes
+  // Damping changes: before step `step`, dof_damping[damped_dofs[k]] = values[k].
+  struct DampingChange {
+    int step = 0;
+    std::vector<double> values;
+  };
+  std::vector<DampingChange> damping;
+  // Per step, row-major: ctrl (nu), resulting qpos (nq), actuator force of that step (nu)
+  // and the joint damping force of that step, -dof_damping * qvel at the step's start,
+  // for the damped dofs (ndamp), so motor plus damping gives the joint torque.
+  std::vector<double> ctrl, qpos, actuator_force, damping_force;
+  int steps() const { return nu > 0 ? static_cast<int>(ctrl.size()) / nu : 0; }
+};
+
+struct RolloutStats {
+  int steps = 0;           // integration steps taken
+  double time = 0;         // simulated time at the end (s)
+  bool unstable = false;   // stopped because the simulation blew up
+  std::string instability; // what blew up
+};
+
+// Runs from the worker's current state (the caller resets it and sets the initial
+// state) for at most max_steps. `damped_dofs` lists the dofs whose dof_damping the hooks
+// may write (recorded on change). `recorder` may be null.
+RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
+                         const std::vector<int>& damped_dofs, StepRecorder* recorder);
+
+// Replays a record on `m` (a plain, freshly loaded model) with mj_step and returns the
+// largest |qpos difference| from the recorded qpos over all steps. `m` is modified
+// (dof_damping), so pass a private copy.
+double replay(mjModel* m, const StepRecorder& record);
+
+}  // namespace diverse

@@ -1,0 +1,55 @@
+#include "task/constraints.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace diverse {
+
+ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
+  const TaskConstraints& c = task.constraints;
+  ConstraintReport report;
+  auto add = [&](const char* name, double violation, double penalty) {
+    report.terms.push_back({name, violation, penalty});
+    report.total += penalty;
+  };
+  auto quadratic = [&](const char* name, double d) { add(name, d, c.weight * d * d); };
+
+  if (motion.unstable) {
+    add("unstable", 1, 3 * c.fall_penalty);
+    report.fell = true;
+    return report;
+  }
+  const double progress = std::clamp(motion.fall_progress, 0.0, 1.0);
+  add("fall", motion.fell ? 1 : 0, motion.fell ? c.fall_penalty * (2 - progress) : 0);
+  report.fell = motion.fell;
+
+  if (c.landing) {
+    const double d = std::max(0.0, std::fabs(motion.feet_x - c.landing_center) - c.landing_half_width);
+    quadratic("landing", d);
+  }
+  if (c.on_box) {
+    const SceneObject* box = task.find_object(c.on_box_object);
+    const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;
+    const double dx = std::max({0.0, lo - motion.feet_x, motion.feet_x - hi});
+    // The foot centre sits one foot radius above the surface it stands on.
+    const double dz = std::max(0.0, box->height - motion.feet_z);
+    quadratic("on_box", std::hypot(dx, dz));
+  }
+  if (c.clearance) {
+    quadratic("clearance", std::max(0.0, c.min_clearance - motion.min_clearance));
+  }
+  if (c.min_length) {
+    quadratic("min_length", std::max(0.0, c.min_length_value - motion.feet_x));
+  }
+  if (c.peak_height) {
+    quadratic("peak_height", std::max(0.0, c.peak_height_min - motion.peak_com_z));
+  }
+  if (c.rotation) {
+    const double d = std::max(0.0, std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns) -
+                                       c.rotation_tolerance);
+    add("rotation", d, d > 0 ? c.rotation_penalty + c.weight * d * d : 0);
+  }
+  return report;
+}
+
+}  // namespace diverse

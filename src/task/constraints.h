@@ -1,0 +1,52 @@
+// Constraint penalty C(M) of a simulated jump (paper sections 3 and 7.1, SPEC 2.4).
+//
+// C is 0 inside the allowed region and K_c |d|^2 outside it, K_c = weight (5000) and d the
+// amount of violation (m or rad). A fall costs a large constant: fall_penalty when the
+// character falls after landing, rising linearly to 2 * fall_penalty for a fall at the
+// very start (progress 0), so that an optimizer starting among falls still sees which
+// candidates stay up longer (ours; the paper only says "a large constant penalty").
+// Never leaving the ground, or never landing, counts as a fall. A rollout whose
+// simulation blew up costs 3 * fall_penalty. The backflip's rotation requirement adds
+// rotation_penalty plus K_c d^2 when the root's rotation from start to end misses
+// turns * 2 pi by more than the tolerance.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "task/task.h"
+
+namespace diverse {
+
+// What a rollout measured, as the constraints need it.
+struct MotionSummary {
+  bool unstable = false;      // the simulation blew up
+  bool took_off = false;      // became airborne during extend
+  bool landed = false;        // touched down after flight
+  bool settled = false;       // came to rest after landing + settle_time
+  bool fell = false;          // fell, never took off, never landed, or never came to rest
+  std::string fall_reason;    // empty unless fell
+  double fall_progress = 1;   // how far the motion got before falling, in [0, 1]
+  double peak_com_z = 0;      // m, highest whole-body COM during flight
+  double feet_x = 0, feet_z = 0;   // m, mean of the foot centres at the end
+  double rotation_total = 0;  // rad, root pitch at the end minus at the start
+  double rotation_flight = 0; // rad, root pitch at landing minus at take-off
+  double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
+  double end_time = 0;        // s
+};
+
+struct ConstraintTerm {
+  std::string name;        // "fall", "landing", "on_box", "clearance", ...
+  double violation = 0;    // d (m or rad), 0 when satisfied
+  double penalty = 0;      // contribution to C
+};
+
+struct ConstraintReport {
+  std::vector<ConstraintTerm> terms;
+  double total = 0;  // C
+  bool fell = false;
+};
+
+ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion);
+
+}  // namespace diverse

@@ -1,0 +1,287 @@
+#include "task/evaluate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace diverse {
+namespace {
+
+// Drives the controller and watches the motion until its outcome is decided.
+class JumpHooks : public StepHooks {
+ public:
+  JumpHooks(const Task& task, const PlanarHuman& body, JumpController& controller,
+            int obstacle_geom, Evaluation& out)
+      : task_(task), body_(body), controller_(controller), obstacle_(obstacle_geom), out_(out) {
+    out_.summary.min_clearance = task.simulation.clearance_range;
+  }
+
+  void control(mjModel* m, mjData* d) override {
+    contacts_ = scan_contacts(m, d, body_);
+    if (first_) controller_.reset(m, d);
+    controller_.control(m, d, contacts_);
+  }
+
+  bool observe(const mjModel* m, const mjData* d) override {
+    MotionSummary& s = out_.summary;
+    const double t = d->time;
+    const double pitch = d->qpos[body_.root_pitch_qpos];
+    const int phase = controller_.phase();
+    const bool changed = controller_.phase_changed();
+    if (first_) {
+      pitch0_ = pitch;
+      first_ = false;
+    }
+    const double com_z = controller_.com()[2];
+
+    // Events.
+    if (phase == kRise && changed) {
+      s.took_off = true;
+      pitch_takeoff_ = pitch;
+    }
+    const bool airborne = phase == kRise || phase == kFall;
+    if (airborne || (phase == kLand && changed && s.took_off)) {
+      out_.flight_time.push_back(t);
+      out_.flight_qpos.insert(out_.flight_qpos.end(), d->qpos, d->qpos + m->nq);
+    }
+    if (airborne) s.peak_com_z = std::max(s.peak_com_z, com_z);
+    if (phase == kLand && changed) {
+      if (!s.took_off || controller_.extend_timed_out()) return fall(t, "never left the ground", d);
+      s.landed = true;
+      s.rotation_flight = pitch - pitch_takeoff_;
+    }
+
+    // Obstacle proximity (contacts in the margin gap included).
+    if (obstacle_ >= 0) {
+      for (int i = 0; i < d->ncon; ++i) {
+        const mjContact& c = d->contact[i];
+        if (c.geom1 == obstacle_ || c.geom2 == obstacle_) {
+          s.min_clearance = std::min(s.min_clearance, c.dist);
+        }
+      }
+    }
+
+    // Falls.
+    if (contacts_.non_foot) return fall(t, "a body other than the feet touched the ground or an object", d);
+    if (!airborne) {
+      const double feet_z = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + 2] +
+                                   d->geom_xpos[3 * body_.foot_geom[1] + 2]);
+      if (com_z - feet_z < task_.simulation.fall_com_height) {
+        return fall(t, "the centre of mass dropped to the feet", d);
+      }
+    }
+
+    // End of the motion.
+    const TaskSimulation& sim = task_.simulation;
+    if (s.landed) {
+      const double since = t - controller_.phase_times().landing();
+      const auto& v = controller_.com_velocity();
+      if (since >= sim.settle_time && std::hypot(v[0], v[2]) < sim.settle_speed) {
+        s.settled = true;
+        return finish(t, d);
+      }
+      if (since >= sim.settle_max) return fall(t, "did not come to rest after landing", d);
+    }
+    if (t + m->opt.timestep > sim.max_time) {
+      return fall(t, s.took_off ? "did not land in time" : "never left the ground", d);
+    }
+    return false;
+  }
+
+ private:
+  double progress(double t) const {
+    const int phase = controller_.phase();
+    if (phase == kLand && out_.summary.landed) {
+      const double since = t - controller_.phase_times().landing();
+      return (5 + std::min(1.0, since / task_.simulation.settle_time)) / static_cast<double>(kNumJumpPhases);
+    }
+    return static_cast<double>(std::min(phase, 5)) / static_cast<double>(kNumJumpPhases);
+  }
+
+  bool fall(double t, const char* why, const mjData* d) {
+    MotionSummary& s = out_.summary;
+    s.fell = true;
+    s.fall_reason = why;
+    s.fall_progress = progress(t);
+    return finish(t, d);
+  }
+
+  bool finish(double t, const mjData* d) {
+    MotionSummary& s = out_.summary;
+    s.end_time = t;
+    s.feet_x = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0]] + d->geom_xpos[3 * body_.foot_geom[1]]);
+    s.feet_z = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + 2] +
+                      d->geom_xpos[3 * body_.foot_geom[1] + 2]);
+    s.rotation_total = d->qpos[body_.root_pitch_qpos] - pitch0_;
+    return true;
+  }
+
+  const Task& task_;
+  const PlanarHuman& body_;
+  JumpController& controller_;
+  int obstacle_;
+  Evaluation& out_;
+  ContactState contacts_;
+  bool first_ = true;
+  double pitch0_ = 0, pitch_takeoff_ = 0;
+};
+
+}  // namespace
+
+TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
+  model_ = SharedModel::from_xml(scene_xml(task_), task_.character);
+  body_ = std::make_unique<PlanarHuman>(model_->get(), task_.character);
+  if (task_.constraints.clearance) {
+    obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());
+  }
+}
+
+ParameterSet TaskEvaluator::parameters() const {
+  const auto& specs = JumpController::parameter_specs();
+  std::vector<double> values;
+  for (const ParamSpec& s : specs) values.push_back(s.lower);
+  return ParameterSet(specs, values);
+}
+
+ParameterSet TaskEvaluator::load_parameters(const std::string& path) const {
+  std::ifstream in(path);
+  if (!in) throw UserError(path + ": cannot read the parameter file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw UserError(path + ": expected valid JSON (" + std::string(e.what()) + ")");
+  }
+  ParameterSet p = parameters();
+  if (j.is_object() && j.contains("parameters")) {
+    p.set_from_json(j["parameters"], path);
+  } else {
+    p.set_from_json(j, path);
+  }
+  return p;
+}
+
+std::unique_ptr<SimWorker> TaskEvaluator::make_worker() const {
+  return std::make_unique<SimWorker>(model_);
+}
+
+Evaluation TaskEvaluator::evaluate_normalized(const Eigen::VectorXd& x, SimWorker& worker,
+                                              const EvaluationOptions& options) const {
+  ParameterSet p = parameters();
+  if (x.size() != p.size()) throw std::logic_error("evaluate_normalized: wrong dimension");
+  for (int i = 0; i < x.size(); ++i) {
+    if (!(x[i] >= 0 && x[i] <= 1)) {
+      Evaluation e;
+      e.failed = true;
+      e.fell = true;
+      e.failure = "normalized parameter " + p.specs()[i].name + " outside [0, 1]";
+      e.summary.unstable = true;
+      e.report = evaluate_constraints(task_, e.summary);
+      e.constraint = e.report.total;
+      return e;
+    }
+  }
+  p.set_normalized(x);
+  return evaluate(p.values(), worker, options);
+}
+
+Evaluation TaskEvaluator::evaluate(const std::vector<double>& values, SimWorker& worker,
+                                   const EvaluationOptions& options) const {
+  if (&worker.shared() != model_.get()) {
+    throw std::logic_error("TaskEvaluator::evaluate: worker belongs to another model");
+  }
+  Evaluation e;
+  worker.reset();
+  mjModel* m = worker.model();
+  JumpController controller(*body_, task_.controller_config);
+  controller.set_parameters(values);
+  e.flight_time.reserve(1024);
+  e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
+  JumpHooks hooks(task_, *body_, controller, obstacle_geom_, e);
+  const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
+  e.stats = run_rollout(worker, hooks, max_steps, controller.damped_dofs(), options.recorder);
+  e.phases = controller.phase_times();
+  if (e.stats.unstable) {
+    e.failed = true;
+    e.failure = "simulation unstable: " + e.stats.instability;
+    e.summary.unstable = true;
+  }
+  e.report = evaluate_constraints(task_, e.summary);
+  e.constraint = e.report.total;
+  e.fell = e.report.fell;
+  if (!e.failed && options.samples_per_phase > 0 && e.has_flight() && e.summary.landed) {
+    std::vector<double> taus;
+    for (int k = 0; k < options.samples_per_phase; ++k) {
+      taus.push_back((k + 0.5) / options.samples_per_phase);
+    }
+    for (int phase = 0; phase < 2; ++phase) {
+      auto poses = sample_poses(e, phase, taus, worker);
+      e.poses.insert(e.poses.end(), poses.begin(), poses.end());
+    }
+  }
+  return e;
+}
+
+std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int phase,
+                                                    const std::vector<double>& taus,
+                                                    SimWorker& worker) const {
+  if (!e.has_flight() || e.flight_time.empty()) {
+    throw std::logic_error("sample_poses: the evaluation has no flight");
+  }
+  const mjModel* m = worker.model();
+  mjData* d = worker.data();
+  const int nq = m->nq;
+  const double a = phase == 0 ? e.phases.takeoff() : e.phases.peak();
+  const double b = phase == 0 ? e.phases.peak() : e.phases.landing();
+  std::vector<PoseSample> out;
+  for (double tau : taus) {
+    const double t = a + std::clamp(tau, 0.0, 1.0) * (b - a);
+    // Bracketing recorded states; linear interpolation (all joints are hinges or slides).
+    const auto& ts = e.flight_time;
+    size_t hi = std::lower_bound(ts.begin(), ts.end(), t) - ts.begin();
+    hi = std::min(hi, ts.size() - 1);
+    const size_t lo = hi > 0 ? hi - 1 : 0;
+    const double w = (hi == lo || ts[hi] == ts[lo]) ? 1.0 : std::clamp((t - ts[lo]) / (ts[hi] - ts[lo]), 0.0, 1.0);
+    for (int i = 0; i < nq; ++i) {
+      d->qpos[i] = (1 - w) * e.flight_qpos[lo * nq + i] + w * e.flight_qpos[hi * nq + i];
+    }
+    mj_kinematics(m, d);
+    PoseSample p;
+    p.phase = phase;
+    p.phase_time = tau;
+    p.time = t;
+    p.link_com.resize(3, static_cast<int>(body_->links.size()));
+    for (size_t k = 0; k < body_->links.size(); ++k) {
+      for (int c = 0; c < 3; ++c) p.link_com(c, static_cast<int>(k)) = d->xipos[3 * body_->links[k] + c];
+    }
+    p.angles.resize(static_cast<int>(body_->joints.size()) + 1);
+    for (size_t k = 0; k < body_->joints.size(); ++k) p.angles[static_cast<int>(k)] = d->qpos[body_->joints[k].qpos];
+    p.angles[static_cast<int>(body_->joints.size())] = d->qpos[body_->root_pitch_qpos];
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+Eigen::VectorXd TaskEvaluator::link_masses() const {
+  Eigen::VectorXd masses(static_cast<int>(body_->links.size()));
+  for (size_t k = 0; k < body_->links.size(); ++k) masses[static_cast<int>(k)] = model_->get()->body_mass[body_->links[k]];
+  return masses;
+}
+
+std::vector<std::string> TaskEvaluator::link_names() const {
+  std::vector<std::string> names;
+  for (int b : body_->links) names.push_back(mj_id2name(model_->get(), mjOBJ_BODY, b));
+  return names;
+}
+
+std::vector<std::string> TaskEvaluator::angle_names() const {
+  std::vector<std::string> names;
+  for (const PlanarJoint& j : body_->joints) names.push_back(j.name);
+  names.push_back("root");
+  return names;
+}
+
+}  // namespace diverse

@@ -1,0 +1,354 @@
+#include "task/task.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "core/error.h"
+
+namespace diverse {
+namespace fs = std::filesystem;
+namespace {
+
+std::string num(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// Strict reader of one TOML table; `path` is the dotted name used in messages.
+class Reader {
+ public:
+  Reader(std::string file, const toml::table& table, std::string path)
+      : file_(std::move(file)), table_(table), path_(std::move(path)) {}
+
+  // Rejects keys not in `known`.
+  void only(std::initializer_list<const char*> known) const {
+    for (const auto& [key, node] : table_) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || key.str() == k;
+      if (!ok) {
+        std::string list;
+        for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
+        fail(std::string(key.str()), "expected no such key (unknown key; known keys: " + list + ")");
+      }
+    }
+  }
+  bool has(const char* key) const { return table_.contains(key); }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& expectation) const {
+    throw_field_error(file_, field(key), expectation);
+  }
+  std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  double number(const char* key, double lo, double hi) const {
+    const toml::node* n = table_.get(key);
+    const std::string expect = "expected a number in [" + num(lo) + ", " + num(hi) + "]";
+    if (n == nullptr) fail(key, expect + " (missing)");
+    double v = 0;
+    if (auto f = n->as_floating_point()) {
+      v = f->get();
+    } else if (auto i = n->as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(key, expect);
+    }
+    if (!std::isfinite(v) || v < lo || v > hi) fail(key, expect + ", got " + num(v));
+    return v;
+  }
+  double number(const char* key, double lo, double hi, double fallback) const {
+    return has(key) ? number(key, lo, hi) : fallback;
+  }
+  long long integer(const char* key, long long lo, long long hi) const {
+    const toml::node* n = table_.get(key);
+    const std::string expect =
+        "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (n == nullptr) fail(key, expect + " (missing)");
+    auto i = n->as_integer();
+    if (!i) fail(key, expect);
+    const long long v = i->get();
+    if (v < lo || v > hi) fail(key, expect + ", got " + std::to_string(v));
+    return v;
+  }
+  long long integer(const char* key, long long lo, long long hi, long long fallback) const {
+    return has(key) ? integer(key, lo, hi) : fallback;
+  }
+  std::string string(const char* key) const {
+    const toml::node* n = table_.get(key);
+    if (n == nullptr) fail(key, "expected a string (missing)");
+    auto s = n->as_string();
+    if (!s) fail(key, "expected a string");
+    return s->get();
+  }
+  std::string string(const char* key, const std::string& fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+  bool boolean(const char* key, bool fallback) const {
+    if (!has(key)) return fallback;
+    auto b = table_.get(key)->as_boolean();
+    if (!b) fail(key, "expected true or false");
+    return b->get();
+  }
+  const toml::table* table(const char* key, bool required) const {
+    const toml::node* n = table_.get(key);
+    if (n == nullptr) {
+      if (required) fail(key, "expected a table (missing)");
+      return nullptr;
+    }
+    if (!n->is_table()) fail(key, "expected a table");
+    return n->as_table();
+  }
+  Reader sub(const char* key, const toml::table& t) const { return Reader(file_, t, field(key)); }
+  const toml::table& raw() const { return table_; }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  const toml::table& table_;
+  std::string path_;
+};
+
+std::string resolve(const std::string& task_file, const std::string& relative) {
+  fs::path p(relative);
+  if (p.is_absolute()) return p.lexically_normal().string();
+  return (fs::path(task_file).parent_path() / p).lexically_normal().string();
+}
+
+std::string existing_file(const Reader& r, const char* key) {
+  const std::string path = resolve(r.file(), r.string(key));
+  if (!fs::is_regular_file(path)) {
+    r.fail(key, "expected an existing file (relative to the task file), but " + path +
+                    " does not exist");
+  }
+  return path;
+}
+
+void read_controller(const Reader& r, Task& task) {
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "balance_kp",
+          "balance_kd", "balance_max_force", "gravity_compensation"});
+  task.controller = r.string("type");
+  if (task.controller != "jump2d") r.fail("type", "expected \"jump2d\", got \"" + task.controller + "\"");
+  JumpControllerConfig& c = task.controller_config;
+  c.landing_control = r.boolean("landing_control", c.landing_control);
+  c.landing_height = r.number("landing_height", 0, 3, c.landing_height);
+  c.extend_timeout = r.number("extend_timeout", 0.1, 3, c.extend_timeout);
+  c.balance_kp = r.number("balance_kp", 0, 10000, c.balance_kp);
+  c.balance_kd = r.number("balance_kd", 0, 5000, c.balance_kd);
+  c.balance_max_force = r.number("balance_max_force", 0, 5000, c.balance_max_force);
+  c.gravity_compensation = r.number("gravity_compensation", 0, 2, c.gravity_compensation);
+}
+
+void read_objects(const Reader& r, const toml::node* node, Task& task) {
+  if (node == nullptr) return;
+  const toml::array* list = node->as_array();
+  if (list == nullptr) r.fail("objects", "expected an array of tables ([[objects]])");
+  for (size_t i = 0; i < list->size(); ++i) {
+    const std::string where = "objects[" + std::to_string(i) + "]";
+    const toml::table* t = list->get(i)->as_table();
+    if (t == nullptr) r.fail(where, "expected a table");
+    Reader o(r.file(), *t, where);
+    o.only({"name", "kind", "x_min", "x_max", "height"});
+    SceneObject obj;
+    obj.name = o.string("name");
+    if (obj.name.empty()) o.fail("name", "expected a non-empty string");
+    for (const SceneObject& other : task.objects) {
+      if (other.name == obj.name) o.fail("name", "expected a unique name, \"" + obj.name + "\" repeats");
+    }
+    obj.kind = o.string("kind");
+    if (obj.kind != "box" && obj.kind != "obstacle") {
+      o.fail("kind", "expected \"box\" or \"obstacle\", got \"" + obj.kind + "\"");
+    }
+    obj.x_min = o.number("x_min", -20, 20);
+    obj.x_max = o.number("x_max", -20, 20);
+    if (obj.x_max <= obj.x_min) o.fail("x_max", "expected a number greater than x_min");
+    obj.height = o.number("height", 0, 3);
+    task.objects.push_back(obj);
+  }
+}
+
+void require_object(const Reader& r, const Task& task, const char* key, const std::string& name,
+                    const char* kind) {
+  const SceneObject* obj = task.find_object(name);
+  if (obj == nullptr || obj->kind != kind) {
+    r.fail(key, std::string("expected the name of an object of kind \"") + kind + "\", got \"" +
+                    name + "\"");
+  }
+}
+
+void read_constraints(const Reader& r, Task& task) {
+  r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
+          "peak_height", "rotation"});
+  TaskConstraints& c = task.constraints;
+  c.weight = r.number("weight", 1e-6, 1e9);
+  c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
+  if (auto t = r.table("landing", false)) {
+    Reader s = r.sub("landing", *t);
+    s.only({"center", "half_width"});
+    c.landing = true;
+    c.landing_center = s.number("center", -20, 20);
+    c.landing_half_width = s.number("half_width", 0.001, 10);
+  }
+  if (auto t = r.table("on_box", false)) {
+    Reader s = r.sub("on_box", *t);
+    s.only({"object", "margin"});
+    c.on_box = true;
+    c.on_box_object = s.string("object");
+    require_object(s, task, "object", c.on_box_object, "box");
+    c.on_box_margin = s.number("margin", 0, 5);
+  }
+  if (auto t = r.table("clearance", false)) {
+    Reader s = r.sub("clearance", *t);
+    s.only({"object", "min_clearance"});
+    c.clearance = true;
+    c.clearance_object = s.string("object");
+    require_object(s, task, "object", c.clearance_object, "obstacle");
+    c.min_clearance = s.number("min_clearance", 0, 1);
+  }
+  if (auto t = r.table("min_length", false)) {
+    Reader s = r.sub("min_length", *t);
+    s.only({"length"});
+    c.min_length = true;
+    c.min_length_value = s.number("length", -20, 20);
+  }
+  if (auto t = r.table("peak_height", false)) {
+    Reader s = r.sub("peak_height", *t);
+    s.only({"min"});
+    c.peak_height = true;
+    c.peak_height_min = s.number("min", 0, 5);
+  }
+  if (auto t = r.table("rotation", false)) {
+    Reader s = r.sub("rotation", *t);
+    s.only({"turns", "tolerance", "penalty"});
+    c.rotation = true;
+    c.rotation_turns = s.number("turns", -3, 3);
+    c.rotation_tolerance = s.number("tolerance", 0.01, 3.14);
+    c.rotation_penalty = s.number("penalty", 0, 1e12);
+  }
+}
+
+void read_simulation(const Reader& r, Task& task) {
+  r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
+          "clearance_range"});
+  TaskSimulation& s = task.simulation;
+  s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
+  s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
+  s.settle_max = r.number("settle_max", s.settle_time, 20, std::max(s.settle_max, s.settle_time));
+  s.max_time = r.number("max_time", 0.5, 60, s.max_time);
+  s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
+  s.clearance_range = r.number("clearance_range", 0.01, 2, s.clearance_range);
+}
+
+void read_seed(const Reader& r, Task& task) {
+  r.only({"base", "object", "heights", "generations", "sigma", "popsize", "seed", "robustness"});
+  TaskSeed& s = task.seed;
+  s.base = existing_file(r, "base");
+  s.object = r.string("object", "");
+  if (!s.object.empty() && task.find_object(s.object) == nullptr) {
+    r.fail("object", "expected the name of a scene object, got \"" + s.object + "\"");
+  }
+  if (r.has("heights")) {
+    const toml::array* a = r.raw().get("heights")->as_array();
+    if (a == nullptr) r.fail("heights", "expected an array of numbers in [0, 3]");
+    for (const toml::node& n : *a) {
+      double v = -1;
+      if (auto f = n.as_floating_point()) v = f->get();
+      if (auto i = n.as_integer()) v = static_cast<double>(i->get());
+      if (!(v >= 0 && v <= 3)) r.fail("heights", "expected an array of numbers in [0, 3]");
+      s.heights.push_back(v);
+    }
+  }
+  if (!s.object.empty() && s.heights.empty()) {
+    r.fail("heights", "expected continuation heights for the object (missing)");
+  }
+  s.generations = static_cast<int>(r.integer("generations", 1, 100000, s.generations));
+  s.sigma = r.number("sigma", 1e-4, 1, s.sigma);
+  s.popsize = static_cast<int>(r.integer("popsize", 2, 1000, s.popsize));
+  s.seed = static_cast<std::uint64_t>(r.integer("seed", 0, (1LL << 62), 1));
+  s.robustness = r.number("robustness", 0, 1e6, s.robustness);
+}
+
+}  // namespace
+
+const SceneObject* Task::find_object(const std::string& object_name) const {
+  for (const SceneObject& o : objects) {
+    if (o.name == object_name) return &o;
+  }
+  return nullptr;
+}
+
+Task load_task(const std::string& path) {
+  if (!fs::is_regular_file(path)) throw UserError(path + ": cannot read the task file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::string what(e.description());
+    throw UserError(path + ": line " + std::to_string(e.source().begin.line) +
+                    ": expected valid TOML (" + what + ")");
+  }
+  Task task;
+  task.file = path;
+  Reader r(path, root, "");
+  r.only({"name", "description", "character", "metric", "variations", "m0", "controller",
+          "simulation", "objects", "constraints", "seed"});
+  task.name = r.string("name");
+  if (task.name.empty()) r.fail("name", "expected a non-empty string");
+  task.description = r.string("description", "");
+  task.character = existing_file(r, "character");
+  task.metric = r.string("metric");
+  if (task.metric != "hf" && task.metric != "md" && task.metric != "wja") {
+    r.fail("metric", "expected \"hf\", \"md\" or \"wja\", got \"" + task.metric + "\"");
+  }
+  task.variations = static_cast<int>(r.integer("variations", 1, 100));
+  task.m0 = resolve(path, r.string("m0"));
+  read_controller(r.sub("controller", *r.table("controller", true)), task);
+  read_objects(r, root.get("objects"), task);
+  if (auto t = r.table("simulation", false)) read_simulation(r.sub("simulation", *t), task);
+  read_constraints(r.sub("constraints", *r.table("constraints", true)), task);
+  if (auto t = r.table("seed", false)) read_seed(r.sub("seed", *t), task);
+  return task;
+}
+
+std::string resolve_task_path(const std::string& name_or_path) {
+  if (fs::is_regular_file(name_or_path)) return name_or_path;
+  for (const std::string& dir : {std::string("tasks"), std::string(DIVERSE_SOURCE_DIR) + "/tasks"}) {
+    const std::string candidate = dir + "/" + name_or_path + ".toml";
+    if (fs::is_regular_file(candidate)) return candidate;
+  }
+  throw UserError(name_or_path +
+                  ": expected a task file or the name of one in tasks/ (no such task)");
+}
+
+std::string scene_xml(const Task& task) {
+  std::ifstream in(task.character, std::ios::binary);
+  if (!in) throw UserError(task.character + ": cannot read the model file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string xml = buffer.str();
+  std::ostringstream geoms;
+  geoms.precision(17);
+  for (const SceneObject& o : task.objects) {
+    const double hx = 0.5 * (o.x_max - o.x_min), hz = 0.5 * std::max(o.height, 1e-3);
+    geoms << "    <geom name=\"" << o.name << "\" type=\"box\" pos=\"" << o.x_min + hx << " 0 " << hz
+          << "\" size=\"" << hx << " 1 " << hz << "\" contype=\"0\" conaffinity=\"1\"";
+    if (o.kind == "obstacle") {
+      // Near-contacts in the gap are reported (exclude = 1) but exert no force.
+      geoms << " margin=\"" << task.simulation.clearance_range << "\" gap=\""
+            << task.simulation.clearance_range << "\" rgba=\"0.8 0.3 0.3 1\"";
+    } else {
+      geoms << " rgba=\"0.4 0.5 0.8 1\"";
+    }
+    geoms << "/>\n";
+  }
+  const size_t at = xml.rfind("</worldbody>");
+  if (at == std::string::npos) {
+    throw UserError(task.character + ": expected a <worldbody> element in the model");
+  }
+  xml.insert(at, geoms.str());
+  return xml;
+}
+
+}  // namespace diverse

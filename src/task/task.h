@@ -1,0 +1,109 @@
+// Task files: what a skill must achieve, with which character and controller.
+//
+// A task is a TOML file (tasks/<name>.toml) naming the character model, the controller
+// and its constants, scene objects, the constraints of paper section 7.1 (SPEC 5) with
+// their parameters and penalties (SPEC 2.4), the paper's distance metric, the default
+// number of variations N, where the input motion M0's parameters are, and how
+// `diverse seed-motion` finds that M0. Paths in a task file are relative to the file.
+//
+// Parsing is strict: a missing field, an unknown key, a wrong type, an out-of-range
+// value, a model or parameter path that does not exist, or malformed TOML is a UserError
+// of one line, "FILE: FIELD: expected ...". docs/character-and-controller.md lists every
+// field.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "control/jump_controller.h"
+
+namespace diverse {
+
+// A box standing on the floor, spanning x in [x_min, x_max] and z in [0, height] (m);
+// it is as deep as the floor in y. Kinds: "box" (something to land on) and "obstacle"
+// (something to clear: its near-contacts within `clearance_range` are reported, so the
+// clearance constraint sees how close the body came).
+struct SceneObject {
+  std::string name;
+  std::string kind;      // "box" or "obstacle"
+  double x_min = 0, x_max = 0, height = 0;  // m
+};
+
+struct TaskConstraints {
+  double weight = 5000;           // K_c in C = K_c |d|^2 (SPEC 2.4)
+  double fall_penalty = 100000;   // constant for a fall (doubles for the earliest falls)
+  // Landing box: feet (mean of the two foot centres) end within center +- half_width (x).
+  bool landing = false;
+  double landing_center = 0, landing_half_width = 0.15;  // m
+  // On top of a box object, at least `on_box_margin` from its edges.
+  bool on_box = false;
+  std::string on_box_object;
+  double on_box_margin = 0.1;  // m
+  // Clearance of an obstacle object: smallest body-obstacle distance >= min_clearance.
+  bool clearance = false;
+  std::string clearance_object;
+  double min_clearance = 0;  // m
+  // Minimum jump length: feet end at x >= min_length.
+  bool min_length = false;
+  double min_length_value = 0;  // m
+  // Minimum peak height of the whole-body COM.
+  bool peak_height = false;
+  double peak_height_min = 0;  // m
+  // Root rotation from start to end within turns * 2 pi +- tolerance.
+  bool rotation = false;
+  double rotation_turns = 1;        // full turns, positive = backwards
+  double rotation_tolerance = 0.5;  // rad
+  double rotation_penalty = 100000; // constant added when violated
+};
+
+struct TaskSimulation {
+  double settle_time = 1.0;       // s the character must stand after landing
+  double settle_speed = 0.25;     // m/s: COM speed below which it is at rest
+  double settle_max = 2.5;        // s after landing by which it must be at rest
+  double max_time = 6.0;          // s, hard cap of a rollout
+  double fall_com_height = 0.3;   // m: COM closer than this to the feet's height = fall
+  double clearance_range = 0.3;   // m: distance up to which obstacle proximity is seen
+};
+
+struct TaskSeed {
+  std::string base;               // resolved path of the hand-authored start parameters
+  std::string object;             // continuation object ("" = none)
+  std::vector<double> heights;    // continuation heights (m), last = the task's height
+  int generations = 100;          // CMA-ES generations per continuation stage (max)
+  double sigma = 0.08;            // initial CMA-ES step (normalized units)
+  int popsize = 16;
+  std::uint64_t seed = 1;
+  double robustness = 0;          // weight of the margin tie-breaker (0 = penalty alone)
+};
+
+struct Task {
+  std::string file;         // the task file as given
+  std::string name;
+  std::string description;
+  std::string character;    // resolved model path
+  std::string controller = "jump2d";
+  JumpControllerConfig controller_config;
+  std::vector<SceneObject> objects;
+  TaskConstraints constraints;
+  TaskSimulation simulation;
+  std::string metric;       // "hf", "md" or "wja"
+  int variations = 4;       // N
+  std::string m0;           // resolved path of M0's parameters (need not exist yet)
+  TaskSeed seed;
+
+  const SceneObject* find_object(const std::string& name) const;
+};
+
+// Parses and validates a task file. Throws UserError.
+Task load_task(const std::string& path);
+
+// A task argument: a path to a .toml file, or a name looked up as tasks/<name>.toml in
+// the current directory and then in the source tree. Throws UserError if none exists.
+std::string resolve_task_path(const std::string& name_or_path);
+
+// The task's MJCF: the character model with the scene objects added to its worldbody.
+// Throws UserError if the character file cannot be read.
+std::string scene_xml(const Task& task);
+
+}  // namespace diverse

@@ -1,0 +1,454 @@
+#include "optimize/diversity.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.h"
+#include "core/thread_pool.h"
+#include "optimize/objective.h"
+
+namespace diverse {
+namespace {
+
+struct PointOutcome : Outcome {
+  Eigen::VectorXd x;
+};
+
+// Points in [0, 1]^dim; feasible inside a ball around the reference; squared Euclidean
+// distance. Points with x[0] > fail_above are failed evaluations with a NaN constraint
+// (a simulation that blew up). Counts evaluations.
+class BallProblem : public DiversityProblem {
+ public:
+  BallProblem(int dim, double radius, double fail_above = 2.0)
+      : dim_(dim), radius_(radius), fail_above_(fail_above) {}
+  int dim() const override { return dim_; }
+  Eigen::VectorXd reference() const override { return Eigen::VectorXd::Constant(dim_, 0.4); }
+  std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int) const override {
+    evaluations.fetch_add(1);
+    auto out = std::make_shared<PointOutcome>();
+    out->x = x;
+    if (x[0] > fail_above_) {
+      out->failed = true;
+      out->constraint = std::numeric_limits<double>::quiet_NaN();
+      return out;
+    }
+    const double e = std::max(0.0, (x - reference()).norm() - radius_);
+    out->constraint = 5000.0 * e * e;
+    return out;
+  }
+  double distance(const Outcome& a, const Outcome& b) const override {
+    return (static_cast<const PointOutcome&>(a).x - static_cast<const PointOutcome&>(b).x)
+        .squaredNorm();
+  }
+  mutable std::atomic<long long> evaluations{0};
+
+ private:
+  int dim_;
+  double radius_;
+  double fail_above_;
+};
+
+// A fixed outcome for objective tests.
+std::shared_ptr<const Outcome> point(double x, double constraint = 0.0, bool failed = false) {
+  auto out = std::make_shared<PointOutcome>();
+  out->x = Eigen::VectorXd::Constant(1, x);
+  out->constraint = constraint;
+  out->failed = failed;
+  return out;
+}
+
+// ---- The objective (paper eq. 1) -------------------------------------------------------
+
+TEST(DiversityObjective, ThreeMotionsByHand) {
+  // M0, M1, M2 at 0, 1, 3 on a line: d01 = 1, d02 = 9, d12 = 4; dmin = 1, 1, 4.
+  // D = -(0 + 0.5 + 2) + 2 (1 + 9 + 4) + (N + 1) K (1 + 1 + 4) with N + 1 = 3.
+  const BallProblem problem(1, 1.0);
+  const std::vector<std::shared_ptr<const Outcome>> set{point(0.0), point(1.0, 0.5),
+                                                        point(3.0, 2.0)};
+  const DiversityScore k10 = score_diversity(problem, set, 10.0);
+  EXPECT_DOUBLE_EQ(k10.D, -2.5 + 28.0 + 3 * 10.0 * 6.0);  // 205.5
+  EXPECT_DOUBLE_EQ(score_diversity(problem, set, 0.0).D, 25.5);
+  EXPECT_DOUBLE_EQ(k10.distance(0, 1), 1.0);
+  EXPECT_DOUBLE_EQ(k10.distance(0, 2), 9.0);
+  EXPECT_DOUBLE_EQ(k10.distance(2, 1), 4.0);
+  EXPECT_EQ(k10.dmin, Eigen::Vector3d(1.0, 1.0, 4.0));
+  EXPECT_EQ(k10.constraint, Eigen::Vector3d(0.0, 0.5, 2.0));
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(k10.distance(i, i), 0.0);
+  EXPECT_EQ(k10.distance, k10.distance.transpose());
+}
+
+TEST(DiversityObjective, MatrixFormAgreesAndDminWeightIsNPlusOneTimesK) {
+  Eigen::MatrixXd d(4, 4);
+  d << 0, 2, 3, 5,  //
+      2, 0, 7, 1,   //
+      3, 7, 0, 4,   //
+      5, 1, 4, 0;
+  const Eigen::Vector4d c(0.0, 1.0, 0.0, 3.0);
+  Eigen::VectorXd dmin;
+  const double k = 2.5;
+  const double value = diversity_objective(d, c, k, &dmin);
+  EXPECT_EQ(dmin, Eigen::Vector4d(2, 1, 3, 1));
+  // Sum over ordered pairs of d (46), minus C (4), plus 4 K sum(dmin) (literal eq. 1).
+  EXPECT_DOUBLE_EQ(value, 46.0 - 4.0 + 4 * k * 7.0);
+  // Raising K by 1 adds (N + 1) sum(dmin).
+  EXPECT_DOUBLE_EQ(diversity_objective(d, c, k + 1.0) - value, 4 * 7.0);
+}
+
+TEST(DiversityObjective, FailedOutcomesScoreBadlyButFinite) {
+  const BallProblem problem(1, 1.0);
+  auto blown_up = std::make_shared<PointOutcome>();
+  blown_up->x = Eigen::VectorXd::Constant(1, std::numeric_limits<double>::infinity());
+  blown_up->failed = true;
+  blown_up->constraint = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::shared_ptr<const Outcome>> set{point(0.0), point(1.0), blown_up};
+  const DiversityScore s = score_diversity(problem, set, 10.0);
+  EXPECT_TRUE(std::isfinite(s.D));
+  EXPECT_EQ(s.constraint[2], kFailedConstraint);
+  EXPECT_EQ(s.distance(0, 2), 0.0);
+  EXPECT_EQ(s.distance(1, 2), 0.0);
+  EXPECT_LT(s.D, -0.5 * kFailedConstraint);
+  // A failure flagged with a finite constraint keeps that value.
+  const DiversityScore flagged =
+      score_diversity(problem, {point(0.0), point(1.0), point(5.0, 50000.0, true)}, 10.0);
+  EXPECT_EQ(flagged.constraint[2], 50000.0);
+  EXPECT_EQ(flagged.distance(0, 2), 0.0);
+  EXPECT_TRUE(is_failure(*point(0.0, std::numeric_limits<double>::infinity())));
+  EXPECT_FALSE(is_failure(*point(0.0, 3.0)));
+}
+
+TEST(DiversityObjective, RejectsBrokenProblemData) {
+  const BallProblem problem(1, 1.0);
+  EXPECT_THROW(score_diversity(problem, {point(0.0), point(1.0, -1.0)}, 10.0), std::logic_error);
+  EXPECT_THROW(diversity_objective(Eigen::MatrixXd::Zero(1, 1), Eigen::VectorXd::Zero(1), 1.0),
+               std::logic_error);
+  EXPECT_THROW(diversity_objective(Eigen::MatrixXd::Zero(3, 3), Eigen::VectorXd::Zero(2), 1.0),
+               std::logic_error);
+  auto nan_point = point(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_THROW(score_diversity(problem, {point(0.0), nan_point}, 10.0), std::logic_error);
+}
+
+// ---- Options and names -----------------------------------------------------------------
+
+TEST(DiversityOptions, StrategyNames) {
+  EXPECT_EQ(parse_strategy("round-robin"), DiversityStrategy::kRoundRobin);
+  EXPECT_EQ(parse_strategy("progressive"), DiversityStrategy::kProgressive);
+  EXPECT_EQ(parse_strategy("joint"), DiversityStrategy::kJoint);
+  try {
+    parse_strategy("greedy", "--strategy");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(),
+                 "--strategy: expected one of round-robin, progressive, joint, got 'greedy'");
+  }
+}
+
+TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
+  DiversityOptions o;
+  EXPECT_NO_THROW(validate(o));
+  auto bad = [](auto mutate) {
+    DiversityOptions b;
+    mutate(b);
+    return b;
+  };
+  EXPECT_THROW(validate(bad([](auto& b) { b.variations = 0; })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.k = -1.0; })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.k = std::nan(""); })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.popsize = 1; })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.sigma0 = 0.0; })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.max_generations = 0; })), std::invalid_argument);
+  EXPECT_THROW(validate(bad([](auto& b) { b.window = -1; })), std::invalid_argument);
+  o.variations = 7;
+  o.k = 3.25;
+  o.strategy = DiversityStrategy::kJoint;
+  o.seed = 0xfedcba9876543210ULL;
+  const DiversityOptions back = diversity_options_from_json(to_json(o));
+  EXPECT_EQ(to_json(back), to_json(o));
+  EXPECT_EQ(back.seed, o.seed);
+}
+
+// ---- Strategies ------------------------------------------------------------------------
+
+DiversityOptions small_options(DiversityStrategy strategy, long long generations) {
+  DiversityOptions o;
+  o.variations = 3;
+  o.strategy = strategy;
+  o.max_generations = generations;
+  o.window = 0;
+  o.seed = 7;
+  return o;
+}
+
+TEST(DiversityRoundRobin, OneGenerationStepsEveryVariationInTurn) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  const DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 5);
+  DiversityOptimizer opt(problem, o, pool);
+  int callbacks = 0;
+  opt.set_callback([&](const DiversityRecord&) { ++callbacks; });
+  opt.run();
+  EXPECT_EQ(opt.stop_reason(), DiversityStop::kMaxGenerations);
+  EXPECT_EQ(opt.generation(), 5);
+  ASSERT_EQ(opt.log().size(), 15u);
+  EXPECT_EQ(callbacks, 15);
+  for (std::size_t s = 0; s < 15; ++s) {
+    const DiversityRecord& r = opt.log()[s];
+    EXPECT_EQ(r.step, static_cast<long long>(s) + 1);
+    EXPECT_EQ(r.generation, static_cast<long long>(s) / 3 + 1);
+    EXPECT_EQ(r.variation, static_cast<int>(s % 3) + 1);
+    // P0 once, then per step lambda samples and the new mean.
+    EXPECT_EQ(r.evaluations, 1 + r.step * (16 + 1));
+    EXPECT_EQ(r.constraint.size(), 4);
+    EXPECT_EQ(r.dmin.size(), 4);
+    EXPECT_TRUE(std::isfinite(r.D));
+  }
+  EXPECT_EQ(opt.evaluations(), problem.evaluations.load());
+  ASSERT_EQ(opt.paths().size(), 4u);
+  EXPECT_EQ(opt.paths()[0].size(), 1u);
+  for (int v = 1; v <= 3; ++v) {
+    ASSERT_EQ(opt.paths()[v].size(), 6u);
+    EXPECT_EQ(opt.paths()[v][0].x, problem.reference());
+    EXPECT_EQ(opt.paths()[v].back().x, opt.current_parameters()[v]);
+  }
+
+  // The last record describes the current set; the result is the best set ever scored.
+  const DiversityScore current = score_diversity(
+      problem, {problem.evaluate(opt.current_parameters()[0], 0),
+                problem.evaluate(opt.current_parameters()[1], 0),
+                problem.evaluate(opt.current_parameters()[2], 0),
+                problem.evaluate(opt.current_parameters()[3], 0)},
+      o.k);
+  EXPECT_EQ(opt.log().back().D, current.D);
+  const DiversityResult result = opt.result();
+  double best = -std::numeric_limits<double>::infinity();
+  for (const auto& r : opt.log()) best = std::max(best, r.D);
+  EXPECT_EQ(result.score.D, best);
+  EXPECT_EQ(result.score.D, score_diversity(problem, result.outcomes, o.k).D);
+  EXPECT_EQ(result.parameters.size(), 4u);
+  EXPECT_EQ(result.parameters[0], problem.reference());
+  // Diversity went up from the all-at-P0 start (D = 0 there).
+  EXPECT_GT(result.score.D, 1.0);
+}
+
+TEST(DiversityProgressive, AddsVariationsOneAtATimeWithinBudgetShares) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  const DiversityOptions o = small_options(DiversityStrategy::kProgressive, 30);
+  DiversityOptimizer opt(problem, o, pool);
+  opt.run();
+  // Shares: 30 / 3 = 10, then (30 - 10) / 2 = 10, then 10: N steps per generation.
+  EXPECT_EQ(opt.generation(), 30);
+  ASSERT_EQ(opt.log().size(), 90u);
+  for (std::size_t s = 0; s < 90; ++s) {
+    const DiversityRecord& r = opt.log()[s];
+    const int variation = static_cast<int>(s) / 30 + 1;
+    EXPECT_EQ(r.variation, variation) << "step " << s;
+    EXPECT_EQ(r.generation, static_cast<long long>(s) / 3 + 1);
+    EXPECT_EQ(r.constraint.size(), variation + 1);  // only the motions added so far
+  }
+  EXPECT_EQ(opt.evaluations(), 1 + 90 * 17);
+  // Variation 1 is frozen at the best point of its phase: a point of its path.
+  const DiversityResult result = opt.result();
+  ASSERT_EQ(result.parameters.size(), 4u);
+  bool on_path = false;
+  for (const auto& p : opt.paths()[1]) on_path = on_path || p.x == result.parameters[1];
+  EXPECT_TRUE(on_path);
+  EXPECT_EQ(opt.paths()[1].size(), 31u);
+  EXPECT_EQ(opt.paths()[1].back().generation, 10);
+  EXPECT_EQ(opt.paths()[3].front().generation, 0);
+  EXPECT_EQ(opt.paths()[3][1].generation, 21);
+}
+
+TEST(DiversityProgressive, StagnationEndsAPhaseEarly) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  DiversityOptions o = small_options(DiversityStrategy::kProgressive, 300);
+  o.window = 5;
+  o.epsilon = 1e9;  // any window counts as stagnant
+  DiversityOptimizer opt(problem, o, pool);
+  opt.run();
+  EXPECT_EQ(opt.generation(), 15);  // three phases of exactly one window each
+  EXPECT_EQ(opt.stop_reason(), DiversityStop::kStagnation);
+}
+
+TEST(DiversityJoint, OneInstanceOverAllVariations) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  const DiversityOptions o = small_options(DiversityStrategy::kJoint, 5);
+  DiversityOptimizer opt(problem, o, pool);
+  opt.run();
+  ASSERT_EQ(opt.log().size(), 5u);
+  for (const auto& r : opt.log()) EXPECT_EQ(r.variation, 0);
+  // lambda sets of N evaluations, then the N means.
+  EXPECT_EQ(opt.evaluations(), 1 + 5 * (16 * 3 + 3));
+  EXPECT_EQ(opt.evaluations(), problem.evaluations.load());
+  for (int v = 1; v <= 3; ++v) EXPECT_EQ(opt.paths()[v].size(), 6u);
+  EXPECT_GT(opt.result().score.D, 0.0);
+}
+
+TEST(DiversityTermination, StagnationWindow) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 1000);
+  o.window = 4;
+  o.epsilon = 1e9;
+  DiversityOptimizer opt(problem, o, pool);
+  opt.run();
+  EXPECT_EQ(opt.generation(), 4);
+  EXPECT_EQ(opt.stop_reason(), DiversityStop::kStagnation);
+  EXPECT_FALSE(opt.step());  // nothing more once done
+  EXPECT_EQ(opt.generation(), 4);
+
+  // A realistic epsilon stops well before the limit once D levels off.
+  o.epsilon = 1e-6;
+  o.window = 20;
+  DiversityOptimizer settled(problem, o, pool);
+  settled.run();
+  EXPECT_EQ(settled.stop_reason(), DiversityStop::kStagnation);
+  EXPECT_LT(settled.generation(), 1000);
+}
+
+TEST(DiversityFailures, BlownUpSamplesNeverMakeDNonFinite) {
+  // Everything with x[0] > 0.55 fails, well inside the reach of sigma0 = 0.2 from 0.4.
+  const BallProblem problem(2, 0.3, 0.55);
+  ThreadPool pool(2);
+  for (DiversityStrategy s : {DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive,
+                              DiversityStrategy::kJoint}) {
+    DiversityOptions o = small_options(s, 30);
+    o.sigma0 = 0.2;
+    DiversityOptimizer opt(problem, o, pool);
+    opt.run();
+    for (const auto& r : opt.log()) ASSERT_TRUE(std::isfinite(r.D)) << to_string(s);
+    const DiversityResult result = opt.result();
+    for (const auto& out : result.outcomes) EXPECT_FALSE(is_failure(*out)) << to_string(s);
+    for (const auto& p : result.parameters) EXPECT_LE(p[0], 0.55) << to_string(s);
+  }
+}
+
+// ---- Determinism and checkpoints -------------------------------------------------------
+
+void expect_identical(const DiversityOptimizer& a, const DiversityOptimizer& b) {
+  ASSERT_EQ(a.log().size(), b.log().size());
+  for (std::size_t i = 0; i < a.log().size(); ++i) {
+    EXPECT_EQ(to_json(a.log()[i]), to_json(b.log()[i])) << "record " << i;
+    EXPECT_EQ(a.log()[i].D, b.log()[i].D);
+  }
+  ASSERT_EQ(a.paths().size(), b.paths().size());
+  for (std::size_t v = 0; v < a.paths().size(); ++v) {
+    ASSERT_EQ(a.paths()[v].size(), b.paths()[v].size());
+    for (std::size_t k = 0; k < a.paths()[v].size(); ++k) {
+      EXPECT_EQ(a.paths()[v][k].x, b.paths()[v][k].x);
+      EXPECT_EQ(a.paths()[v][k].step, b.paths()[v][k].step);
+    }
+  }
+  const DiversityResult ra = a.result(), rb = b.result();
+  EXPECT_EQ(ra.score.D, rb.score.D);
+  EXPECT_EQ(ra.score.distance, rb.score.distance);
+  EXPECT_EQ(ra.score.constraint, rb.score.constraint);
+  EXPECT_EQ(ra.score.dmin, rb.score.dmin);
+  ASSERT_EQ(ra.parameters.size(), rb.parameters.size());
+  for (std::size_t i = 0; i < ra.parameters.size(); ++i) EXPECT_EQ(ra.parameters[i], rb.parameters[i]);
+  EXPECT_EQ(ra.generations, rb.generations);
+  EXPECT_EQ(ra.evaluations, rb.evaluations);
+  EXPECT_EQ(ra.stop, rb.stop);
+  EXPECT_EQ(a.checkpoint(), b.checkpoint());
+}
+
+class DiversityStrategies : public ::testing::TestWithParam<DiversityStrategy> {};
+
+TEST_P(DiversityStrategies, BitIdenticalForOneTwoAndThreeThreads) {
+  const BallProblem problem(3, 0.3);
+  DiversityOptions o = small_options(GetParam(), 24);
+  o.window = 10;
+  ThreadPool one(1), two(2), three(3);
+  DiversityOptimizer a(problem, o, one), b(problem, o, two), c(problem, o, three);
+  a.run();
+  b.run();
+  c.run();
+  expect_identical(a, b);
+  expect_identical(a, c);
+  // A different seed gives a different run.
+  o.seed += 1;
+  DiversityOptimizer d(problem, o, one);
+  d.run();
+  EXPECT_NE(a.result().score.D, d.result().score.D);
+}
+
+TEST_P(DiversityStrategies, CheckpointResumeMatchesUninterruptedRun) {
+  const BallProblem problem(3, 0.3);
+  const DiversityOptions o = small_options(GetParam(), 24);  // progressive: phases of 8
+  ThreadPool one(1), two(2);
+  DiversityOptimizer whole(problem, o, one);
+  whole.run();
+
+  for (int split : {1, 7, 8, 13}) {
+    DiversityOptimizer first(problem, o, one);
+    for (int g = 0; g < split; ++g) first.step();
+    // Through text, as a checkpoint file would go, and onto another thread count.
+    const std::string text = first.checkpoint().dump();
+    DiversityOptimizer resumed =
+        DiversityOptimizer::from_checkpoint(problem, nlohmann::json::parse(text), two);
+    EXPECT_EQ(resumed.generation(), split);
+    EXPECT_EQ(resumed.checkpoint(), first.checkpoint());
+    resumed.run();
+    expect_identical(whole, resumed);
+  }
+  // A finished run restores as finished.
+  DiversityOptimizer done =
+      DiversityOptimizer::from_checkpoint(problem, whole.checkpoint(), one);
+  EXPECT_TRUE(done.done());
+  EXPECT_EQ(done.result().score.D, whole.result().score.D);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, DiversityStrategies,
+                         ::testing::Values(DiversityStrategy::kRoundRobin,
+                                           DiversityStrategy::kProgressive,
+                                           DiversityStrategy::kJoint),
+                         [](const auto& info) {
+                           std::string name = to_string(info.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
+TEST(DiversityCheckpoint, RejectsACheckpointOfAnotherProblem) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  DiversityOptimizer opt(problem, small_options(DiversityStrategy::kRoundRobin, 3), pool);
+  opt.step();
+  const nlohmann::json state = opt.checkpoint();
+
+  const BallProblem wider(3, 0.3);
+  try {
+    DiversityOptimizer::from_checkpoint(wider, state, pool);
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "checkpoint: reference: expected 3 parameters, got 2");
+  }
+  nlohmann::json moved = state;
+  moved["reference"][0] = 0.5;
+  try {
+    DiversityOptimizer::from_checkpoint(problem, moved, pool);
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "checkpoint: reference: expected the problem's reference parameters");
+  }
+  nlohmann::json other = state;
+  other["format"] = "something else";
+  try {
+    DiversityOptimizer::from_checkpoint(problem, other, pool);
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "checkpoint: format: expected \"diverse.diversity_checkpoint\"");
+  }
+  // A problem whose outcomes differ from the ones checkpointed is caught.
+  const BallProblem tighter(2, 0.05);
+  EXPECT_THROW(DiversityOptimizer::from_checkpoint(tighter, state, pool), std::logic_error);
+}
+
+}  // namespace
+}  // namespace diverse
