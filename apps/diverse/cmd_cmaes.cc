@@ -85,17 +85,16 @@ void run(const CmaesArgs& args) {
                                                "an integer from 1 to " + std::to_string(kMaxDim)));
   options.seed = parse_seed(args.seed);
   if (!args.popsize.empty()) {
-    options.popsize = static_cast<int>(parse_integer(
-        "--popsize", args.popsize, 2, kMaxPopsize,
-        "an integer from 2 to " + std::to_string(kMaxPopsize)));
+    options.popsize =
+        static_cast<int>(parse_integer("--popsize", args.popsize, 2, kMaxPopsize,
+                                       "an integer from 2 to " + std::to_string(kMaxPopsize)));
   }
   options.sigma0 = parse_number("--sigma0", args.sigma0, true);
   options.target_f = parse_number("--target", args.target, false);
   const long long n = options.dim;
-  options.max_evaluations =
-      args.max_evals.empty()
-          ? std::max(10000LL, 1000 * n * n)
-          : parse_integer("--max-evals", args.max_evals, 1, 1LL << 53, "a positive integer");
+  options.max_evaluations = args.max_evals.empty() ? std::max(10000LL, 1000 * n * n)
+                                                   : parse_integer("--max-evals", args.max_evals, 1,
+                                                                   1LL << 53, "a positive integer");
   options.active = !args.no_active;
 
   Cmaes es(options, Eigen::VectorXd::Constant(options.dim, problem->start));

@@ -118,3 +118,13 @@ double PlanarHuman::child_pitch(const double* qpos, int joint_index) const {
 }
 
 }  // namespace diverse
+
+namespace diverse {
+
+double PlanarHuman::child_pitch_rate(const double* qvel, int joint_index) const {
+  double rate = qvel[root_pitch_dof];
+  for (int k : chain_[joint_index]) rate += qvel[joints[k].dof];
+  return rate;
+}
+
+}  // namespace diverse

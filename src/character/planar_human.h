@@ -70,6 +70,8 @@ struct PlanarHuman {
   // World pitch (rad) of a joint's child link: root pitch plus the joint angles from the
   // root to that joint, for the state in qpos.
   double child_pitch(const double* qpos, int joint_index) const;
+  // Its world pitch rate (rad/s) for the velocities in qvel.
+  double child_pitch_rate(const double* qvel, int joint_index) const;
 
  private:
   // For each joint, the joint indices on the path from the root (inclusive of itself).

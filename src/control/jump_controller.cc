@@ -13,7 +13,7 @@ constexpr int kPoseTypes = 8;  // hip .. wrist; neck and head are not parameters
 constexpr const char* kGainJoints[3] = {"hip", "knee", "ankle"};
 
 bool is_stance(int phase) { return phase == kStart || phase == kCrouch || phase == kExtend || phase == kLand; }
-bool has_balance(int phase) { return phase == kStart || phase == kLand; }
+bool has_balance(int phase) { return phase == kStart || phase == kCrouch || phase == kLand; }
 
 double wrap(double a) { return std::remainder(a, 2 * M_PI); }
 
@@ -135,6 +135,7 @@ void JumpController::reset(mjModel* m, const mjData* d) {
   phase_duration_ = start_duration_;
   times_.begin[kStart] = d->time;
   takeoff_com_z_ = 0;
+  free_since_ = -1;
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const int type = body_.joints[i].type;
     m->dof_damping[body_.joints[i].dof] = type <= kAnkle ? kd_[kStart][type] : config_.kd[type];
@@ -245,7 +246,11 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
       if (elapsed >= crouch_duration_) enter(kExtend, t, m);
       break;
     case kExtend:
-      if (!contacts.any) {
+      // Airborne: no contact for airborne_time with the COM rising (soft contacts can
+      // flicker for a step while the legs push).
+      if (contacts.any) free_since_ = -1;
+      else if (free_since_ < 0) free_since_ = t;
+      if (free_since_ >= 0 && t - free_since_ >= config_.airborne_time - 1e-9 && com_vel_[2] > 0) {
         enter(kRise, t, m);
       } else if (elapsed >= config_.extend_timeout) {
         extend_timed_out_ = true;
@@ -314,13 +319,29 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
   }
 
   // PD torques, clamped; damping goes to dof_damping (implicit), the rest to ctrl.
+  // World-frame joints of stance phases damp the tracked link's world pitch rate: the
+  // joint damping -kd qdot (implicit) plus an explicit -kd * (rate of the link on the
+  // other side of the joint), with the sign that makes the sum the tracked link's rate.
+  const bool stance = is_stance(phase_);
+  const double* v = d->qvel;
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const PlanarJoint& j = body_.joints[i];
     const bool phase_gain = j.type <= kAnkle;
     const double kp = phase_gain ? kp_[phase_][j.type] : config_.kp[j.type];
     const double kd = phase_gain ? kd_[phase_][j.type] : config_.kd[j.type];
-    const double qd = d->qvel[j.dof];
-    double tau = kp * (target_[i] - q[j.qpos]) - kd * qd + balance[i];
+    const double qd = v[j.dof];
+    double world_damping = 0;
+    if (stance) {
+      const int side = (j.type == kHip || j.type == kAnkle) ? (i == static_cast<size_t>(body_.by_type[j.type][0]) ? 0 : 1) : 0;
+      if (j.type == kHip) {  // pelvis rate = -(qdot_hip) + thigh rate
+        world_damping = kd * body_.child_pitch_rate(v, body_.by_type[kHip][side]);
+      } else if (j.type == kAnkle) {  // foot rate = qdot_ankle + shin rate
+        world_damping = -kd * body_.child_pitch_rate(v, body_.by_type[kKnee][side]);
+      } else if (j.type == kWaistUpper) {  // chest rate = qdot + abdomen rate
+        world_damping = -kd * body_.child_pitch_rate(v, body_.by_type[kWaistLower][0]);
+      }
+    }
+    double tau = kp * (target_[i] - q[j.qpos]) - kd * qd + world_damping + balance[i];
     tau = std::clamp(tau, -j.torque_limit, j.torque_limit);
     d->ctrl[j.actuator] = tau + kd * qd;
     m->dof_damping[j.dof] = kd;

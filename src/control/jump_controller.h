@@ -5,7 +5,8 @@
 //   start   stance, balance, ends after start.duration
 //   crouch  stance, ends after crouch.duration
 //   extend  stance, targets applied at once (no interpolation) to build momentum,
-//           ends when the character is airborne (no contact with anything)
+//           ends when the character is airborne (no contact with anything for
+//           airborne_time, COM rising)
 //   rise    flight, ends at peak height (COM vertical velocity <= 0); duration predicted
 //           as v_z / g at take-off
 //   fall    flight, ends at the first contact; duration predicted as the ballistic time
@@ -79,6 +80,7 @@ struct JumpControllerConfig {
   bool landing_control = true;       // servo the feet during fall
   double landing_height = 0;         // m, height of the surface the COM prediction uses
   double extend_timeout = 0.8;       // s; an extend that never leaves the ground ends here
+  double airborne_time = 0.01;       // s without contact (COM rising) that counts as take-off
 };
 
 // Times at which phases began (s, simulation time); negative if never reached.
@@ -136,6 +138,7 @@ class JumpController {
   bool extend_timed_out_ = false;
   double phase_begin_ = 0, phase_duration_ = 1;
   double takeoff_com_z_ = 0;
+  double free_since_ = -1;  // time contact was last lost during extend (s), -1 if touching
   PhaseTimes times_;
   // Per joint: target at the start of the phase (rad); in stance phases the world pitch
   // of the tracked link for the world-frame joints (hip, ankle, upper waist).

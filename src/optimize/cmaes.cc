@@ -38,8 +38,8 @@ std::string hex_double(double v) {
   if (std::signbit(v)) *p++ = '-';
   *p++ = '0';
   *p++ = 'x';
-  const auto result = std::to_chars(p, buffer + sizeof(buffer), std::fabs(v),
-                                    std::chars_format::hex);
+  const auto result =
+      std::to_chars(p, buffer + sizeof(buffer), std::fabs(v), std::chars_format::hex);
   return std::string(buffer, result.ptr);
 }
 
@@ -134,7 +134,8 @@ Eigen::MatrixXd parse_matrix(const nlohmann::json& j, const std::string& name, E
 template <typename T>
 T parse_integer(const nlohmann::json& j, const std::string& name) {
   if (j.is_number_integer() &&
-      !(j.is_number_unsigned() && j.get<std::uint64_t>() > std::numeric_limits<std::uint64_t>::max() / 2)) {
+      !(j.is_number_unsigned() &&
+        j.get<std::uint64_t>() > std::numeric_limits<std::uint64_t>::max() / 2)) {
     const long long v = j.get<long long>();
     if (v >= std::numeric_limits<T>::min() && v <= std::numeric_limits<T>::max()) {
       return static_cast<T>(v);
@@ -243,9 +244,9 @@ void Cmaes::set_constants() {
   // positive definite (52).
   double alpha_neg = 0;
   if (options_.active && sum_neg < 0) {
-    const double alpha_mu_minus = 1 + k_.c1 / k_.cmu;                               // (50)
-    const double alpha_mueff_minus = 1 + 2 * k_.mueff_minus / (mueff + 2);          // (51)
-    const double alpha_posdef_minus = (1 - k_.c1 - k_.cmu) / (nd * k_.cmu);         // (52)
+    const double alpha_mu_minus = 1 + k_.c1 / k_.cmu;                        // (50)
+    const double alpha_mueff_minus = 1 + 2 * k_.mueff_minus / (mueff + 2);   // (51)
+    const double alpha_posdef_minus = (1 - k_.c1 - k_.cmu) / (nd * k_.cmu);  // (52)
     alpha_neg = std::min({alpha_mu_minus, alpha_mueff_minus, alpha_posdef_minus});
   }
   k_.weights.resize(lambda);
@@ -267,8 +268,8 @@ Eigen::VectorXd Cmaes::to_box(const Eigen::VectorXd& genotype) const {
   Eigen::VectorXd x(genotype.size());
   for (Eigen::Index i = 0; i < genotype.size(); ++i) {
     double t = genotype[i] - lower;
-    t -= period * std::floor(t / period);  // [0, period) up to rounding
-    if (t > width) t = period - t;         // mirror the second half-period
+    t -= period * std::floor(t / period);        // [0, period) up to rounding
+    if (t > width) t = period - t;               // mirror the second half-period
     x[i] = std::clamp(lower + t, lower, upper);  // rounding only; never a real clip
   }
   return x;
@@ -353,8 +354,8 @@ void Cmaes::tell(const std::vector<double>& fitness) {
   // h_sigma stalls the update of p_c while ||p_sigma|| is large (below (47)); the
   // generation counter g starts at 0.
   const double g1 = static_cast<double>(generation_ + 1);
-  const bool h_sigma = ps_norm / std::sqrt(1 - std::pow(1 - k_.cs, 2 * g1)) <
-                       (1.4 + 2 / (n + 1.0)) * k_.chi_n;
+  const bool h_sigma =
+      ps_norm / std::sqrt(1 - std::pow(1 - k_.cs, 2 * g1)) < (1.4 + 2 / (n + 1.0)) * k_.chi_n;
 
   // (45) p_c <- (1 - c_c) p_c + h_sigma sqrt(c_c (2 - c_c) mueff) <y>_w.
   pc_ = (1 - k_.cc) * pc_;
@@ -556,11 +557,14 @@ Cmaes Cmaes::from_json(const nlohmann::json& state) {
   o.lower = parse_hex_double(field(jo, "lower", "options."), "options.lower");
   o.upper = parse_hex_double(field(jo, "upper", "options."), "options.upper");
   o.target_f = parse_hex_double(field(jo, "target_f", "options."), "options.target_f");
-  o.max_evaluations = parse_integer<long long>(field(jo, "max_evaluations", "options."), "options.max_evaluations");
-  o.max_generations = parse_integer<long long>(field(jo, "max_generations", "options."), "options.max_generations");
+  o.max_evaluations =
+      parse_integer<long long>(field(jo, "max_evaluations", "options."), "options.max_evaluations");
+  o.max_generations =
+      parse_integer<long long>(field(jo, "max_generations", "options."), "options.max_generations");
   o.tol_fun = parse_hex_double(field(jo, "tol_fun", "options."), "options.tol_fun");
   o.tol_x = parse_hex_double(field(jo, "tol_x", "options."), "options.tol_x");
-  o.max_condition = parse_hex_double(field(jo, "max_condition", "options."), "options.max_condition");
+  o.max_condition =
+      parse_hex_double(field(jo, "max_condition", "options."), "options.max_condition");
   if (o.dim < 1) state_error("options.dim", "an integer >= 1");
 
   Cmaes es;
@@ -583,7 +587,8 @@ Cmaes Cmaes::from_json(const nlohmann::json& state) {
   es.B_ = parse_matrix(field(state, "B"), "B", n, n);
   es.D_ = parse_vector(field(state, "D"), "D", n);
   es.condition_ = parse_hex_double(field(state, "condition"), "condition");
-  es.eigen_generation_ = parse_integer<long long>(field(state, "eigen_generation"), "eigen_generation");
+  es.eigen_generation_ =
+      parse_integer<long long>(field(state, "eigen_generation"), "eigen_generation");
   if (!(es.sigma_ > 0) || !std::isfinite(es.sigma_)) state_error("sigma", "positive and finite");
   if (!es.ps_.allFinite() || !es.pc_.allFinite() || !es.C_.allFinite() || !es.B_.allFinite() ||
       !es.D_.allFinite()) {
@@ -601,8 +606,8 @@ Cmaes Cmaes::from_json(const nlohmann::json& state) {
 
   const nlohmann::json& jh = field(state, "recent_best");
   if (!jh.is_array() || static_cast<int>(jh.size()) > es.k_.history_length) {
-    state_error("recent_best", "an array of at most " + std::to_string(es.k_.history_length) +
-                                   " numbers");
+    state_error("recent_best",
+                "an array of at most " + std::to_string(es.k_.history_length) + " numbers");
   }
   for (const auto& f : jh) es.recent_best_.push_back(parse_hex_double(f, "recent_best"));
   es.best_x_ = parse_vector(field(state, "best_x"), "best_x", n);

@@ -78,11 +78,11 @@ enum class StopReason {
 const char* to_string(StopReason reason);
 
 struct CmaesOptions {
-  int dim = 0;                  // n, number of parameters (>= 1)
-  int popsize = 0;              // lambda (>= 2); 0 = default 4 + floor(3 ln n)
-  double sigma0 = 0.3;          // initial step size (> 0, in parameter units)
-  std::uint64_t seed = 1;       // RNG seed; 0 is a valid seed like any other
-  bool active = true;           // active covariance update (negative weights)
+  int dim = 0;             // n, number of parameters (>= 1)
+  int popsize = 0;         // lambda (>= 2); 0 = default 4 + floor(3 ln n)
+  double sigma0 = 0.3;     // initial step size (> 0, in parameter units)
+  std::uint64_t seed = 1;  // RNG seed; 0 is a valid seed like any other
+  bool active = true;      // active covariance update (negative weights)
   // Box bounds (reflection, see above). Ignored unless bounded; lower < upper.
   bool bounded = false;
   double lower = 0.0;
@@ -104,9 +104,9 @@ struct CmaesConstants {
   double mueff = 0;         // variance-effective selection mass of the positive weights
   double mueff_minus = 0;   // same for the negative part of the raw weights
   double cc = 0, cs = 0, c1 = 0, cmu = 0, damps = 0, cm = 1;
-  double chi_n = 0;         // E||N(0, I)||
-  double lazy_gap = 0;      // generations between eigendecompositions (at least)
-  int history_length = 0;   // recent-best window of tol_fun: 10 + ceil(30 n / lambda)
+  double chi_n = 0;        // E||N(0, I)||
+  double lazy_gap = 0;     // generations between eigendecompositions (at least)
+  int history_length = 0;  // recent-best window of tol_fun: 10 + ceil(30 n / lambda)
 };
 
 class Cmaes {

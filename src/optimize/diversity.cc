@@ -260,19 +260,33 @@ void DiversityOptimizer::run() {
 void DiversityOptimizer::step_variation(int v) {
   Cmaes& es = cmas_[v - 1];
   const std::vector<Eigen::VectorXd> xs = es.ask();
-  std::vector<double> fitness(xs.size());
-  // Each sample replaces M_v in the current set; CMA minimizes, so it is told -D.
-  pool_->parallel_for(xs.size(), [&](std::size_t k, int worker) {
-    const auto outcome = checked(problem_->evaluate(xs[k], worker));
-    fitness[k] = -replaced_objective(*problem_, outcomes_, current_, v, *outcome, options_.k);
-  });
+
+  // The previous step's new mean rides along with this step's samples, so that its
+  // single evaluation does not leave the other workers idle.
+  std::vector<Eigen::VectorXd> batch = xs;
+  if (pending_ > 0) batch.push_back(points_[pending_]);
+  const auto outcomes = evaluate_all(*problem_, *pool_, batch);
+  if (pending_ > 0) settle_pending(outcomes.back());
   evaluations_ += static_cast<long long>(xs.size());
+
+  // Each sample replaces M_v in the current set; CMA minimizes, so it is told -D.
+  std::vector<double> fitness(xs.size());
+  pool_->parallel_for(xs.size(), [&](std::size_t k, int) {
+    fitness[k] = -replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
+  });
   es.tell(fitness);
 
-  // The new mean is what the other variations' samples are scored against from now on.
+  // The new mean is what the other variations' samples are scored against from now on;
+  // it is evaluated with the next batch (or at the end of the generation).
   points_[v] = es.mean();
-  outcomes_[v] = evaluate_all(*problem_, *pool_, {points_[v]}).front();
+  pending_ = v;
+}
+
+void DiversityOptimizer::settle_pending(std::shared_ptr<const Outcome> outcome) {
+  outcomes_[pending_] = std::move(outcome);
   evaluations_ += 1;
+  const int v = pending_;
+  pending_ = 0;
   finish_step(v);
 }
 
@@ -338,6 +352,7 @@ void DiversityOptimizer::finish_step(int variation) {
 }
 
 void DiversityOptimizer::end_generation() {
+  if (pending_ > 0) settle_pending(evaluate_all(*problem_, *pool_, {points_[pending_]}).front());
   best_history_.push_back(best_.score.D);
   const int window = options_.window;
   auto stagnated = [&](long long since) {

@@ -25,7 +25,8 @@
 // A "step" is one CMA generation of one instance; the log has one record per step.
 // On top of the sample evaluations, the mean of every instance that moved is evaluated
 // again (one evaluation per variation per step): its outcome is what the other variations'
-// samples are scored against. `evaluations` counts both.
+// samples are scored against. `evaluations` counts both. That evaluation is batched with
+// the next step's samples, so a step's log record and callback come once it is known.
 //
 // Termination, checked at the end of each generation: the generation limit; stagnation
 // (the best D improved by less than epsilon over the last `window` generations); or every
@@ -172,6 +173,7 @@ class DiversityOptimizer {
   void step_variation(int variation);
   void step_joint();
   void rescore();
+  void settle_pending(std::shared_ptr<const Outcome> outcome);
   void finish_step(int variation);
   void end_generation();
   void start_phase();
@@ -196,6 +198,8 @@ class DiversityOptimizer {
   int active_ = 0;
   long long phase_start_ = 0;
   long long phase_budget_ = 0;
+  // Variation whose new mean awaits evaluation (0 = none); always 0 between generations.
+  int pending_ = 0;
 
   std::vector<DiversityRecord> log_;
   std::vector<std::vector<PathPoint>> paths_;

@@ -184,6 +184,7 @@ struct OffscreenRenderer::Impl {
   mjrContext gl;
   std::vector<unsigned char> rgb;  // supersampled picture, bottom row first
   std::vector<float> depth;
+  float clear_depth = 1.0f;  // depth where nothing was drawn (1 in MuJoCo 2.2; 0 if reverse-Z)
 
   void make_current() {
     if (!OSMesaMakeCurrent(context, window.data(), GL_UNSIGNED_BYTE, 1, 1)) {
@@ -265,25 +266,44 @@ struct OffscreenRenderer::Impl {
   // Adds the overhead light when the model has none. Its shadow map covers a cylinder
   // around the light ray through the centre of the bodies' current bounding box, just wide
   // enough for the bodies: all their shadows fall inside it (the map is an orthographic
-  // projection along the light), and the small radius keeps the map's texels at ~2 mm, free
-  // of the self-shadowing "acne" a map spread over the whole view shows on the floor.
+  // projection along the light), and the small radius keeps the map's texels at 2-3 mm,
+  // free of the self-shadowing "acne" a map spread over the whole view shows on the floor.
   void add_light(const SideCamera& camera) {
     if (!style.add_light || copy->nlight > 0 || scene.nlight >= mjMAXLIGHT) return;
+    // Static scene objects in view (boxes, obstacles) are included, so their shadows do not
+    // come and go with the character's position.
+    const double half_view = camera.distance * std::tan(0.5 * camera.fovy * kDegree) *
+                             static_cast<double>(width) / height;
     Bounds bodies;
     for (int g = 0; g < copy->ngeom; ++g) {
-      if (copy->geom_bodyid[g] != 0 && copy->geom_group[g] <= 2) {
-        add_geom_bounds(copy.get(), data.get(), g, bodies);
+      if (copy->geom_group[g] > 2 || copy->geom_type[g] == mjGEOM_PLANE) continue;
+      if (copy->geom_bodyid[g] == 0 &&
+          std::abs(data->geom_xpos[3 * g] - camera.lookat[0]) > half_view) {
+        continue;
+      }
+      add_geom_bounds(copy.get(), data.get(), g, bodies);
+    }
+    // A map spread wider than about 2.2 mm per texel shows acne: then the static objects
+    // are left out and only the moving bodies get the map.
+    const double max_texel = 0.0022;  // m
+    const auto radius_of = [](const Bounds& b) {
+      double diagonal = 0.0;
+      for (int i = 0; i < 3; ++i) diagonal += (b.hi[i] - b.lo[i]) * (b.hi[i] - b.lo[i]);
+      return 0.5 * std::sqrt(diagonal) + 0.05;
+    };
+    if (!bodies.empty() && 2.0 * radius_of(bodies) / gl.shadowSize > max_texel) {
+      bodies = Bounds{};
+      for (int g = 0; g < copy->ngeom; ++g) {
+        if (copy->geom_bodyid[g] != 0 && copy->geom_group[g] <= 2) {
+          add_geom_bounds(copy.get(), data.get(), g, bodies);
+        }
       }
     }
     std::array<double, 3> centre = camera.lookat;
     double radius = 1.0;
     if (!bodies.empty()) {
-      double diagonal = 0.0;
-      for (int i = 0; i < 3; ++i) {
-        centre[i] = 0.5 * (bodies.lo[i] + bodies.hi[i]);
-        diagonal += (bodies.hi[i] - bodies.lo[i]) * (bodies.hi[i] - bodies.lo[i]);
-      }
-      radius = 0.5 * std::sqrt(diagonal) + 0.05;
+      for (int i = 0; i < 3; ++i) centre[i] = 0.5 * (bodies.lo[i] + bodies.hi[i]);
+      radius = radius_of(bodies);
     }
     gl.shadowClip = static_cast<float>(radius);
 
@@ -333,6 +353,12 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
   m->vis.global.offheight = height * ss;
   m->vis.quality.offsamples = 0;
   m->vis.quality.shadowsize = std::max(style.shadow_size, 64);
+  // Coarser built-in meshes than MuJoCo's defaults (28 slices, 16 stacks, 4 quads per box
+  // side): llvmpipe lights per vertex and draws the scene up to three times with shadows, so
+  // vertices dominate the cost; at these sizes the silhouettes look the same.
+  m->vis.quality.numslices = std::min(m->vis.quality.numslices, 20);
+  m->vis.quality.numstacks = std::min(m->vis.quality.numstacks, 10);
+  m->vis.quality.numquads = 1;
   m->vis.headlight.active = 1;
   for (int i = 0; i < 3; ++i) {
     m->vis.headlight.ambient[i] = 0.35f;
@@ -362,6 +388,18 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
     OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
     OSMesaDestroyContext(r.context);
     throw std::runtime_error("render: MuJoCo could not create its offscreen framebuffer");
+  }
+  // Read the depth an empty picture leaves, rather than assume MuJoCo's depth convention.
+  {
+    mj_kinematics(m, r.data.get());
+    mjvCamera cam;
+    mjv_defaultFreeCamera(m, &cam);
+    mjv_updateScene(m, r.data.get(), &r.option, nullptr, &cam, mjCAT_ALL, &r.scene);
+    r.scene.ngeom = 0;
+    r.scene.flags[mjRND_SKYBOX] = 0;
+    const mjrRect pixel{0, 0, 1, 1};
+    mjr_render(pixel, &r.scene, &r.gl);
+    mjr_readPixels(nullptr, &r.clear_depth, pixel, &r.gl);
   }
   r.rgb.resize(static_cast<std::size_t>(width) * height * ss * ss * 3);
   r.depth.resize(static_cast<std::size_t>(width) * height * ss * ss);
@@ -413,13 +451,13 @@ Image OffscreenRenderer::render(std::span<const double> qpos, const SideCamera& 
   mjr_render(viewport, &r.scene, &r.gl);
   mjr_readPixels(r.rgb.data(), r.depth.data(), viewport, &r.gl);
 
-  // Paint the sky where nothing was drawn, from sky_top at the top of the picture to
+  // Paint the sky where nothing was drawn (depth still at its cleared value), from sky_top at the top of the picture to
   // sky_bottom at the horizon (the lowest row with sky), then average ss x ss samples per
   // pixel. GL rows run bottom-up; the image's run top-down.
   int horizon = 0;  // supersampled rows from the top
   for (int row = 0; row < H; ++row) {
     const float* line = r.depth.data() + static_cast<std::size_t>(row) * W;
-    if (std::any_of(line, line + W, [](float z) { return z >= 1.0f; })) {
+    if (std::any_of(line, line + W, [&r](float z) { return z == r.clear_depth; })) {
       horizon = std::max(horizon, H - 1 - row);
     }
   }
@@ -443,7 +481,7 @@ Image OffscreenRenderer::render(std::span<const double> qpos, const SideCamera& 
         const std::size_t row = static_cast<std::size_t>(H - 1 - row_from_top);
         for (int i = 0; i < ss; ++i) {
           const std::size_t k = row * W + x * ss + i;
-          if (r.depth[k] >= 1.0f) {
+          if (r.depth[k] == r.clear_depth) {
             const Rgb& c = sky[row_from_top];
             sum[0] += c.r;
             sum[1] += c.g;

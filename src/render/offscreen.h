@@ -13,7 +13,8 @@
 // model's <visual><global offwidth offheight>; the renderer keeps its own copy of the model
 // with that size (and the camera's field of view, near/far planes and headlight) set for the
 // picture, so any model works. The scene is drawn at `supersample` times the requested size
-// without multisampling, the empty background (depth buffer at the far plane) is replaced by
+// without multisampling, the empty background (depth buffer still at its cleared value) is
+// replaced by
 // a sky gradient, and the result is box-filtered down: edges are smooth and silhouettes blend
 // with the sky rather than with the GL clear colour. Floor bands (alternating tones every
 // `band_width` along x) make travelled distance readable; ground strips mark x-intervals
@@ -114,7 +115,7 @@ struct RenderStyle {
   Rgb band_dark{198, 198, 196};
   bool add_light = true;  // add a shadow-casting overhead light if the model has no lights
   bool shadows = true;    // about half the cost of a picture (llvmpipe)
-  int shadow_size = 1024;  // px, side of the shadow map (the model's 4096 costs 4x more)
+  int shadow_size = 1536;  // px, side of the shadow map (the model's 4096 costs far more)
   int supersample = 2;     // render at this multiple of the size, then box-filter (1..4)
 };
 

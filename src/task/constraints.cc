@@ -52,4 +52,25 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
   return report;
 }
 
+double constraint_margin(const Task& task, const MotionSummary& motion) {
+  const TaskConstraints& c = task.constraints;
+  double margin = 1.0;  // m; no constraint is looser than this counts
+  if (c.landing) {
+    margin = std::min(margin, c.landing_half_width - std::fabs(motion.feet_x - c.landing_center));
+  }
+  if (c.on_box) {
+    const SceneObject* box = task.find_object(c.on_box_object);
+    const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;
+    margin = std::min({margin, motion.feet_x - lo, hi - motion.feet_x});
+  }
+  if (c.clearance) margin = std::min(margin, motion.min_clearance - c.min_clearance);
+  if (c.min_length) margin = std::min(margin, motion.feet_x - c.min_length_value);
+  if (c.peak_height) margin = std::min(margin, motion.peak_com_z - c.peak_height_min);
+  if (c.rotation) {
+    const double miss = std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns);
+    margin = std::min(margin, 0.2 * (c.rotation_tolerance - miss));
+  }
+  return margin;
+}
+
 }  // namespace diverse

@@ -49,4 +49,10 @@ struct ConstraintReport {
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion);
 
+// How far inside the allowed region the motion is: the smallest slack (m) over the
+// task's geometric constraints (landing box, box edges, clearance, length, peak height;
+// rotation slack counts 0.2 m per rad), negative when violated. Used only to prefer
+// robust input motions when seeding (`diverse seed-motion`), never inside C.
+double constraint_margin(const Task& task, const MotionSummary& motion);
+
 }  // namespace diverse

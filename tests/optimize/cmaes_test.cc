@@ -99,8 +99,7 @@ INSTANTIATE_TEST_SUITE_P(
     Pycma, CmaesReference,
     testing::Values(ReferenceCase{"sphere", 10, 1585}, ReferenceCase{"ellipsoid", 10, 4235},
                     ReferenceCase{"rosenbrock", 10, 5200}, ReferenceCase{"sphere", 30, 4368},
-                    ReferenceCase{"ellipsoid", 30, 27622},
-                    ReferenceCase{"rosenbrock", 30, 35581}),
+                    ReferenceCase{"ellipsoid", 30, 27622}, ReferenceCase{"rosenbrock", 30, 35581}),
     [](const testing::TestParamInfo<ReferenceCase>& param_info) {
       return std::string(param_info.param.function) + std::to_string(param_info.param.n);
     });
@@ -508,7 +507,9 @@ INSTANTIATE_TEST_SUITE_P(
                     // At n = 100 the saved eigensystem is a generation old.
                     ResumeCase{"n100_stale_eigensystem", 100, 16, true, false, 13, false, 1600},
                     ResumeCase{"bounded_passive", 6, 0, false, true, 25, true, 60000}),
-    [](const testing::TestParamInfo<ResumeCase>& param_info) { return std::string(param_info.param.name); });
+    [](const testing::TestParamInfo<ResumeCase>& param_info) {
+      return std::string(param_info.param.name);
+    });
 
 TEST(Cmaes, StateStoresSpecialValuesExactly) {
   CmaesOptions o;
@@ -596,7 +597,8 @@ CommandResult run_command(const std::string& arguments) {
   if (pipe == nullptr) return result;
   char buffer[4096];
   size_t read = 0;
-  while ((read = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.output.append(buffer, read);
+  while ((read = std::fread(buffer, 1, sizeof buffer, pipe)) > 0)
+    result.output.append(buffer, read);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;

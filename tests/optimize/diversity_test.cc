@@ -94,8 +94,9 @@ TEST(DiversityObjective, MatrixFormAgreesAndDminWeightIsNPlusOneTimesK) {
   const double k = 2.5;
   const double value = diversity_objective(d, c, k, &dmin);
   EXPECT_EQ(dmin, Eigen::Vector4d(2, 1, 3, 1));
-  // Sum over ordered pairs of d (46), minus C (4), plus 4 K sum(dmin) (literal eq. 1).
-  EXPECT_DOUBLE_EQ(value, 46.0 - 4.0 + 4 * k * 7.0);
+  // Sum over ordered pairs of d (2 x 22), minus C (4), plus (N + 1) K sum(dmin) with
+  // N + 1 = 4 (literal eq. 1).
+  EXPECT_DOUBLE_EQ(value, 44.0 - 4.0 + 4 * k * 7.0);
   // Raising K by 1 adds (N + 1) sum(dmin).
   EXPECT_DOUBLE_EQ(diversity_objective(d, c, k + 1.0) - value, 4 * 7.0);
 }
@@ -409,8 +410,8 @@ INSTANTIATE_TEST_SUITE_P(All, DiversityStrategies,
                          ::testing::Values(DiversityStrategy::kRoundRobin,
                                            DiversityStrategy::kProgressive,
                                            DiversityStrategy::kJoint),
-                         [](const auto& info) {
-                           std::string name = to_string(info.param);
+                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
+                           std::string name = to_string(p.param);
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
                            return name;
                          });

@@ -1,0 +1,122 @@
+// `diverse run [TASK]` and `diverse resume DIR`: diverse motions for a task.
+//
+//   diverse run backflip --n 4 --generations 500 --out runs/backflip
+//   diverse resume runs/backflip
+//
+// See src/run/run.h for what a run directory holds.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "command.h"
+#include "core/error.h"
+#include "metric/metric.h"
+#include "optimize/diversity.h"
+#include "run/run.h"
+
+namespace diverse::cli {
+namespace {
+
+constexpr const char* kDefaultTask = "backflip";
+
+struct RunArgs {
+  std::string task = kDefaultTask;
+  int n = 0;
+  std::string metric;
+  double k = 10.0;
+  long long generations = 500;
+  std::string strategy = "round-robin";
+  std::uint64_t seed = 1;
+  int threads = 0;
+  int popsize = 16;
+  double sigma0 = 0.1;
+  int window = 100;
+  double epsilon = 1e-6;
+  std::string out;
+  bool force = false;
+  bool quiet = false;
+  bool no_render = false;
+};
+
+void install_run(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Find N diverse variations of a task's input motion (default task: backflip)");
+  cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or path to a task file")
+      ->capture_default_str();
+  cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)");
+  cmd->add_option("--metric", args->metric, "Distance metric: hf, md or wja (default: the task's)");
+  cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")->capture_default_str();
+  cmd->add_option("--generations", args->generations, "Generation limit")->capture_default_str();
+  cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  cmd->add_option("--threads", args->threads, "Worker threads (0 = one per core)")
+      ->capture_default_str();
+  cmd->add_option("--popsize", args->popsize, "CMA-ES samples per generation (lambda)")
+      ->capture_default_str();
+  cmd->add_option("--sigma0", args->sigma0, "Initial CMA-ES step, in normalized units")
+      ->capture_default_str();
+  cmd->add_option("--window", args->window,
+                  "Stop when D improves by less than --epsilon over this many generations (0 = off)")
+      ->capture_default_str();
+  cmd->add_option("--epsilon", args->epsilon, "See --window")->capture_default_str();
+  cmd->add_option("--out", args->out, "Run directory (default: runs/<task>)");
+  cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
+  cmd->add_flag("--quiet", args->quiet, "No progress output");
+  cmd->add_flag("--no-render", args->no_render, "Do not write filmstrip.png");
+  cmd->callback([args] {
+    const RunArgs& a = *args;
+    if (a.n < 0) throw UserError("--n: expected an integer >= 1, got " + std::to_string(a.n));
+    if (!(a.k >= 0.0)) throw UserError("--k: expected a number >= 0, got " + std::to_string(a.k));
+    if (a.generations < 1)
+      throw UserError("--generations: expected an integer >= 1, got " + std::to_string(a.generations));
+    if (a.popsize < 2)
+      throw UserError("--popsize: expected an integer >= 2, got " + std::to_string(a.popsize));
+    if (!(a.sigma0 > 0.0 && a.sigma0 <= 1.0))
+      throw UserError("--sigma0: expected a number in (0, 1], got " + std::to_string(a.sigma0));
+    if (a.window < 0) throw UserError("--window: expected an integer >= 0");
+    if (!(a.epsilon >= 0.0)) throw UserError("--epsilon: expected a number >= 0");
+    if (!a.metric.empty()) parse_metric(a.metric);
+    RunRequest request;
+    request.task = a.task;
+    request.metric = a.metric;
+    request.options.variations = a.n;
+    request.options.k = a.k;
+    request.options.max_generations = a.generations;
+    request.options.strategy = parse_strategy(a.strategy);
+    request.options.seed = a.seed;
+    request.options.popsize = a.popsize;
+    request.options.sigma0 = a.sigma0;
+    request.options.window = a.window;
+    request.options.epsilon = a.epsilon;
+    request.threads = a.threads;
+    request.force = a.force;
+    request.quiet = a.quiet;
+    request.render = !a.no_render;
+    std::string task_name = a.task;
+    if (const auto slash = task_name.find_last_of('/'); slash != std::string::npos)
+      task_name = task_name.substr(slash + 1);
+    if (const auto dot = task_name.rfind(".toml"); dot != std::string::npos)
+      task_name = task_name.substr(0, dot);
+    request.out = a.out.empty() ? "runs/" + task_name : a.out;
+    start_run(request);
+  });
+}
+
+void install_resume(CLI::App& app) {
+  auto dir = std::make_shared<std::string>();
+  auto threads = std::make_shared<int>(0);
+  auto quiet = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
+  cmd->add_option("dir", *dir, "Run directory")->required();
+  cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")->capture_default_str();
+  cmd->add_flag("--quiet", *quiet, "No progress output");
+  cmd->callback([dir, threads, quiet] { resume_run(*dir, *threads, *quiet); });
+}
+
+const bool registered_run = register_command(30, install_run);
+const bool registered_resume = register_command(31, install_resume);
+
+}  // namespace
+}  // namespace diverse::cli

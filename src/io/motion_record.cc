@@ -1,0 +1,186 @@
+#include "io/motion_record.h"
+
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "io/files.h"
+#include "physics/mujoco_guard.h"
+
+namespace diverse {
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json rows(const std::vector<double>& flat, int width) {
+  nlohmann::json out = nlohmann::json::array();
+  if (width <= 0) return out;
+  for (std::size_t k = 0; k + static_cast<std::size_t>(width) <= flat.size(); k += width)
+    out.push_back(std::vector<double>(flat.begin() + static_cast<long>(k),
+                                      flat.begin() + static_cast<long>(k + width)));
+  return out;
+}
+
+nlohmann::json summary_json(const MotionSummary& s) {
+  return {{"unstable", s.unstable},           {"took_off", s.took_off},
+          {"landed", s.landed},               {"settled", s.settled},
+          {"fell", s.fell},                   {"fall_reason", s.fall_reason},
+          {"peak_com_z", s.peak_com_z},       {"feet_x", s.feet_x},
+          {"feet_z", s.feet_z},               {"rotation_total", s.rotation_total},
+          {"rotation_flight", s.rotation_flight}, {"min_clearance", s.min_clearance},
+          {"end_time", s.end_time}};
+}
+
+}  // namespace
+
+nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                                  const Evaluation& e, const StepRecorder& record,
+                                  const MotionRecordInfo& info, const fs::path& json_path) {
+  nlohmann::json j;
+  j["format"] = "diverse.motion";
+  j["version"] = 1;
+  j["task"] = evaluator.task().name;
+  j["label"] = info.label;
+  j["parameters"] = parameters.to_json();
+
+  nlohmann::json terms = nlohmann::json::array();
+  for (const ConstraintTerm& t : e.report.terms)
+    terms.push_back({{"name", t.name}, {"violation", t.violation}, {"penalty", t.penalty}});
+  j["constraint"] = {{"total", e.constraint}, {"fell", e.fell}, {"failed", e.failed},
+                     {"failure", e.failure}, {"terms", terms}};
+  j["summary"] = summary_json(e.summary);
+
+  nlohmann::json phases = nlohmann::json::array();
+  for (int p = 0; p < kNumJumpPhases; ++p)
+    phases.push_back({{"name", jump_phase_name(p)}, {"begin", e.phases.begin[static_cast<std::size_t>(p)]}});
+  j["phases"] = phases;
+
+  nlohmann::json samples = nlohmann::json::array();
+  for (const PoseSample& s : e.poses) {
+    nlohmann::json com = nlohmann::json::array();
+    for (Eigen::Index c = 0; c < s.link_com.cols(); ++c)
+      com.push_back({s.link_com(0, c), s.link_com(1, c), s.link_com(2, c)});
+    samples.push_back({{"phase", s.phase},
+                       {"phase_time", s.phase_time},
+                       {"time", s.time},
+                       {"link_com", com},
+                       {"angles", std::vector<double>(s.angles.data(), s.angles.data() + s.angles.size())}});
+  }
+  const Eigen::VectorXd masses = evaluator.link_masses();
+  j["pose_samples"] = {{"link_names", evaluator.link_names()},
+                       {"angle_names", evaluator.angle_names()},
+                       {"link_masses", std::vector<double>(masses.data(), masses.data() + masses.size())},
+                       {"samples", samples}};
+
+  nlohmann::json damping = nlohmann::json::array();
+  for (const auto& change : record.damping)
+    damping.push_back({{"step", change.step}, {"values", change.values}});
+  const fs::path base = json_path.has_parent_path() ? json_path.parent_path() : fs::path(".");
+  j["replay"] = {{"model", info.model_path.lexically_relative(base).generic_string()},
+                 {"timestep", record.timestep},
+                 {"nq", record.nq},
+                 {"nu", record.nu},
+                 {"qpos0", record.qpos0},
+                 {"qvel0", record.qvel0},
+                 {"damped_dofs", record.damped_dofs},
+                 {"damping", damping},
+                 {"ctrl", rows(record.ctrl, record.nu)},
+                 {"qpos", rows(record.qpos, record.nq)}};
+  return j;
+}
+
+Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                        const MotionRecordInfo& info, const fs::path& json_path,
+                        StepRecorder* record_out) {
+  StepRecorder record;
+  const auto worker = evaluator.make_worker();
+  EvaluationOptions options;
+  options.recorder = &record;
+  const Evaluation e = evaluator.evaluate(parameters.values(), *worker, options);
+  evaluator.model().save_xml(info.model_path.string());
+  write_json_atomic(json_path, motion_record_json(evaluator, parameters, e, record, info, json_path));
+  if (record_out) *record_out = std::move(record);
+  return e;
+}
+
+StepRecorder read_replay_record(const nlohmann::json& motion, const fs::path& json_path,
+                                fs::path* model_path) {
+  const std::string where = json_path.string();
+  if (!motion.is_object() || motion.value("format", "") != "diverse.motion")
+    throw UserError(where + ": format: expected \"diverse.motion\" (a motion file written by "
+                            "`diverse simulate` or `diverse run`)");
+  if (!motion.contains("replay") || !motion["replay"].is_object())
+    throw UserError(where + ": replay: expected an object with the exact-replay record");
+  const nlohmann::json& r = motion["replay"];
+  StepRecorder record;
+  std::string field;
+  try {
+    field = "model";
+    const fs::path base = json_path.has_parent_path() ? json_path.parent_path() : fs::path(".");
+    if (model_path) *model_path = base / r.at("model").get<std::string>();
+    field = "timestep";
+    record.timestep = r.at("timestep").get<double>();
+    field = "nq";
+    record.nq = r.at("nq").get<int>();
+    field = "nu";
+    record.nu = r.at("nu").get<int>();
+    field = "qpos0";
+    record.qpos0 = r.at("qpos0").get<std::vector<double>>();
+    field = "qvel0";
+    record.qvel0 = r.at("qvel0").get<std::vector<double>>();
+    field = "damped_dofs";
+    record.damped_dofs = r.at("damped_dofs").get<std::vector<int>>();
+    record.ndamp = static_cast<int>(record.damped_dofs.size());
+    field = "damping";
+    for (const auto& change : r.at("damping")) {
+      StepRecorder::DampingChange c;
+      c.step = change.at("step").get<int>();
+      c.values = change.at("values").get<std::vector<double>>();
+      if (static_cast<int>(c.values.size()) != record.ndamp) throw std::invalid_argument("size");
+      record.damping.push_back(std::move(c));
+    }
+    field = "ctrl";
+    for (const auto& row : r.at("ctrl")) {
+      const auto v = row.get<std::vector<double>>();
+      if (static_cast<int>(v.size()) != record.nu) throw std::invalid_argument("row size");
+      record.ctrl.insert(record.ctrl.end(), v.begin(), v.end());
+    }
+    field = "qpos";
+    for (const auto& row : r.at("qpos")) {
+      const auto v = row.get<std::vector<double>>();
+      if (static_cast<int>(v.size()) != record.nq) throw std::invalid_argument("row size");
+      record.qpos.insert(record.qpos.end(), v.begin(), v.end());
+    }
+  } catch (const std::exception&) {
+    throw UserError(where + ": replay." + field + ": missing or malformed");
+  }
+  if (record.qpos0.size() != static_cast<std::size_t>(record.nq) ||
+      record.qvel0.empty() || record.ctrl.size() / std::max(1, record.nu) !=
+                                  record.qpos.size() / std::max(1, record.nq))
+    throw UserError(where + ": replay: expected qpos0 of nq values and as many qpos rows as ctrl rows");
+  return record;
+}
+
+double replay_motion_file(const fs::path& json_path, int* steps) {
+  const nlohmann::json motion = read_json(json_path);
+  fs::path model_path;
+  const StepRecorder record = read_replay_record(motion, json_path, &model_path);
+  const auto model = SharedModel::from_file(model_path.string());
+  mjModel* m = mj_copyModel(nullptr, model->get());
+  if (m->nq != record.nq || m->nu != record.nu || m->nv != static_cast<int>(record.qvel0.size())) {
+    mj_deleteModel(m);
+    throw UserError(json_path.string() + ": replay: nq/nu do not match the model " + model_path.string());
+  }
+  if (std::fabs(m->opt.timestep - record.timestep) > 0) {
+    mj_deleteModel(m);
+    throw UserError(json_path.string() + ": replay.timestep: does not match the model's");
+  }
+  const double diff = replay(m, record);
+  mj_deleteModel(m);
+  if (steps) *steps = record.steps();
+  return diff;
+}
+
+}  // namespace diverse

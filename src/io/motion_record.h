@@ -1,0 +1,67 @@
+// The motion file (SPEC section 7): one simulated motion, complete enough to look at,
+// measure and replay exactly in plain MuJoCo. Written by `diverse simulate` (motion.json)
+// and `diverse run` (motions/m<i>.json); read by `diverse replay`, render, gallery and
+// export.
+//
+//   {
+//     "format": "diverse.motion", "version": 1,
+//     "task": "backflip", "label": "M1",
+//     "parameters": {"name": value, ...},          named controller parameters
+//     "constraint": {"total": C, "fell": false, "terms": [{"name", "violation", "penalty"}]},
+//     "summary": {peak COM height, feet position at the end, rotation, ...},
+//     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never
+//     "pose_samples": {"link_names", "angle_names", "link_masses",
+//                      "samples": [{"phase", "phase_time", "time", "link_com", "angles"}]},
+//     "replay": {
+//       "model": "../model/m1.xml",   path of the MJCF saved by MuJoCo, relative to this file
+//       "timestep": 0.002, "nq": 19, "nu": 16,
+//       "qpos0": [...], "qvel0": [...],            initial state
+//       "damped_dofs": [...],                      dofs whose dof_damping the controller sets
+//       "damping": [{"step": k, "values": [...]}], dof_damping written before step k
+//       "ctrl": [[...], ...],                      per step, the ctrl written before mj_step
+//       "qpos": [[...], ...]                       per step, qpos after mj_step
+//     }
+//   }
+//
+// Replaying: load the model, set qpos0/qvel0, and for every step k apply the damping
+// changes of step k, copy ctrl[k] into d->ctrl and call mj_step; qpos must equal qpos[k].
+// Doubles are written with the shortest representation that parses back to the same bits.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "physics/rollout.h"
+#include "task/evaluate.h"
+
+namespace diverse {
+
+struct MotionRecordInfo {
+  std::string label;                   // "M0", "M1", ... or "" for a single motion
+  std::filesystem::path model_path;    // where the saved model is (or will be) written
+};
+
+// Builds the motion file's JSON. `record` is the rollout's replay record.
+nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                                  const Evaluation& evaluation, const StepRecorder& record,
+                                  const MotionRecordInfo& info,
+                                  const std::filesystem::path& json_path);
+
+// Simulates `parameters` with recording on, saves the model to info.model_path (as
+// MuJoCo writes it) and the motion file to json_path. Returns the evaluation.
+Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                        const MotionRecordInfo& info, const std::filesystem::path& json_path,
+                        StepRecorder* record_out = nullptr);
+
+// Reads the replay part of a motion file. Throws UserError "PATH: replay.FIELD: expected
+// ..." when it is missing or malformed. `model_path` receives the resolved model path.
+StepRecorder read_replay_record(const nlohmann::json& motion, const std::filesystem::path& json_path,
+                                std::filesystem::path* model_path);
+
+// Loads a motion file's model in plain MuJoCo and replays its inputs; returns the
+// largest |qpos difference| from the recorded qpos over all steps (infinity if the
+// replay blew up). Throws UserError if the file or its model cannot be read.
+double replay_motion_file(const std::filesystem::path& json_path, int* steps = nullptr);
+
+}  // namespace diverse

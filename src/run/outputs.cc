@@ -1,0 +1,188 @@
+#include "run/outputs.h"
+
+#include <cmath>
+#include <string>
+
+#include "io/files.h"
+#include "io/motion_record.h"
+#include "physics/model.h"
+#include "render/film_strip.h"
+
+namespace diverse {
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    std::vector<double> row(static_cast<std::size_t>(m.cols()));
+    for (Eigen::Index j = 0; j < m.cols(); ++j) row[static_cast<std::size_t>(j)] = m(i, j);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+ParameterSet named(const ParameterSet& like, const Eigen::VectorXd& x) {
+  ParameterSet p = like;
+  p.set_normalized(x);
+  return p;
+}
+
+// (Built with append: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string.)
+std::string numbered(char prefix, std::size_t i) {
+  std::string s(1, prefix);
+  s.append(std::to_string(i));
+  return s;
+}
+std::string label(std::size_t i) { return numbered('M', i); }
+std::string stem(std::size_t i) { return numbered('m', i); }
+
+}  // namespace
+
+FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
+  FilmColumns columns;
+  const double dt = record.timestep;
+  auto frame_at = [&](double t) {
+    // qpos row k is the state after step k, at time (k + 1) dt; t = 0 is qpos0.
+    const int steps = record.steps();
+    const long k = std::lround(t / dt) - 1;
+    if (k < 0 || steps == 0) return record.qpos0;
+    const long row = std::min<long>(k, steps - 1);
+    return std::vector<double>(record.qpos.begin() + row * record.nq,
+                               record.qpos.begin() + (row + 1) * record.nq);
+  };
+  const PhaseTimes& p = e.phases;
+  const double end = record.steps() * dt;
+  auto add = [&](const std::string& name, double t) {
+    if (t < 0) return;
+    columns.names.push_back(name);
+    columns.frames.push_back(frame_at(t));
+  };
+  add("crouch", p.begin[kCrouch]);
+  add("extend", p.begin[kExtend]);
+  add("take-off", p.takeoff());
+  if (p.takeoff() >= 0 && p.peak() >= 0) add("rising", 0.5 * (p.takeoff() + p.peak()));
+  add("peak", p.peak());
+  if (p.peak() >= 0 && p.landing() >= 0) add("falling", 0.5 * (p.peak() + p.landing()));
+  add("touch-down", p.landing());
+  add("end", end);
+  return columns;
+}
+
+void write_run_outputs(const RunOutputs& o) {
+  const DiversityResult result = o.optimizer.result();
+  const DiversityOptions& options = o.optimizer.options();
+  const std::size_t count = result.parameters.size();
+
+  // Log: one record per step.
+  std::string log;
+  for (const DiversityRecord& r : o.optimizer.log()) log += to_json(r).dump() + "\n";
+  write_file_atomic(o.dir / "log.jsonl", log);
+
+  // Optimization paths as named parameters.
+  const auto& paths = o.optimizer.paths();
+  for (std::size_t v = 1; v < paths.size(); ++v) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const PathPoint& point : paths[v])
+      points.push_back({{"generation", point.generation},
+                        {"step", point.step},
+                        {"parameters", named(o.m0, point.x).to_json()}});
+    write_json_atomic(o.dir / "paths" / (stem(v) + ".json"),
+                      {{"variation", v}, {"metric", to_string(o.problem.metric())}, {"points", points}});
+  }
+
+  // Every motion metric on the final outcomes.
+  nlohmann::json distances;
+  distances["objective"] = to_string(o.problem.metric());
+  for (Metric metric : kMotionMetrics) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(count),
+                                              static_cast<Eigen::Index>(count));
+    for (std::size_t i = 0; i < count; ++i)
+      for (std::size_t j = i + 1; j < count; ++j) {
+        const auto& a = *result.outcomes[i];
+        const auto& b = *result.outcomes[j];
+        const double v = (is_failure(a) || is_failure(b)) ? 0.0 : o.problem.distance(a, b, metric);
+        d(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v;
+        d(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = v;
+      }
+    distances[to_string(metric)] = matrix_json(d);
+  }
+
+  // Motion files (re-simulated with recording on) and the film strip rows.
+  fs::create_directories(o.dir / "motions");
+  fs::create_directories(o.dir / "model");
+  std::vector<Evaluation> evaluations(count);
+  std::vector<StepRecorder> records(count);
+  o.pool.parallel_for(count, [&](std::size_t i, int) {
+    const MotionRecordInfo info{label(i), o.dir / "model" / (stem(i) + ".xml")};
+    evaluations[i] = write_motion(o.evaluator, named(o.m0, result.parameters[i]), info,
+                                  o.dir / "motions" / (stem(i) + ".json"),
+                                  &records[i]);
+  });
+
+  nlohmann::json motions = nlohmann::json::array();
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto& outcome = static_cast<const MotionOutcome&>(*result.outcomes[i]);
+    const auto idx = static_cast<Eigen::Index>(i);
+    motions.push_back({{"index", i},
+                       {"label", label(i)},
+                       {"constraint", result.score.constraint[idx]},
+                       {"dmin", result.score.dmin[idx]},
+                       {"fell", outcome.fell},
+                       {"failed", outcome.failed},
+                       {"landing_x", outcome.landing_x},
+                       {"peak_com_z", outcome.peak_com_z},
+                       {"file", "motions/" + stem(i) + ".json"}});
+  }
+
+  const TaskEvaluator& ev = o.evaluator;
+  nlohmann::json summary = {
+      {"format", "diverse.summary"},
+      {"version", 1},
+      {"task", ev.task().name},
+      {"task_file", ev.task().file},
+      {"metric", to_string(o.problem.metric())},
+      {"N", options.variations},
+      {"K", options.k},
+      {"strategy", to_string(options.strategy)},
+      {"seed", options.seed},
+      {"popsize", options.popsize},
+      {"sigma0", options.sigma0},
+      {"max_generations", options.max_generations},
+      {"generations", result.generations},
+      {"evaluations", result.evaluations},
+      {"stop", to_string(result.stop)},
+      {"D", result.score.D},
+      {"all_satisfied", (result.score.constraint.array() == 0.0).all()},
+      {"motions", motions},
+      {"distances", distances},
+      {"timing",
+       {{"wall_seconds", o.wall_seconds},
+        {"threads", o.pool.size()},
+        {"evaluations_per_second",
+         o.wall_seconds > 0 ? static_cast<double>(result.evaluations) / o.wall_seconds : 0.0}}}};
+  write_json_atomic(o.dir / "summary.json", summary);
+
+  if (!o.render) return;
+  std::vector<FilmRow> rows;
+  std::vector<std::string> names;
+  const auto model = SharedModel::from_file((o.dir / "model" / "m0.xml").string());
+  for (std::size_t i = 0; i < count; ++i) {
+    FilmColumns columns = jump_film_columns(evaluations[i], records[i]);
+    if (columns.names.size() > names.size()) names = columns.names;
+    rows.push_back(FilmRow{model->get(), label(i), std::move(columns.frames)});
+  }
+  FilmStripOptions film;
+  std::string title = ev.task().name + ", metric " + to_string(o.problem.metric()) + ":";
+  for (std::size_t c = 0; c < names.size(); ++c)
+    title += "  " + column_label(static_cast<int>(c)) + " " + names[c];
+  film.title = title;
+  const TaskConstraints& tc = ev.task().constraints;
+  if (tc.landing)
+    film.ground_strips.push_back(
+        {tc.landing_center - tc.landing_half_width, tc.landing_center + tc.landing_half_width});
+  write_film_strip((o.dir / "filmstrip.png").string(), rows, film);
+}
+
+}  // namespace diverse

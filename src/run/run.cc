@@ -1,0 +1,211 @@
+#include "run/run.h"
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/thread_pool.h"
+#include "eval/motion_problem.h"
+#include "io/files.h"
+#include "io/progress.h"
+#include "run/outputs.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+
+namespace diverse {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kRunFormat = "diverse.run";
+constexpr int kRunVersion = 1;
+constexpr const char* kCheckpointFormat = "diverse.run_checkpoint";
+
+// Everything a run needs that is rebuilt from run.json on resume.
+struct RunSetup {
+  std::unique_ptr<TaskEvaluator> evaluator;
+  Metric metric = Metric::kMassDistance;
+  DiversityOptions options;
+  ParameterSet m0;
+  std::string task_path;
+  std::string task_text;
+};
+
+RunSetup make_setup(const std::string& task_path, const std::string& metric_name,
+                    const DiversityOptions& options) {
+  RunSetup setup;
+  setup.task_path = fs::absolute(task_path).lexically_normal().string();
+  setup.task_text = read_file(setup.task_path);
+  Task task = load_task(setup.task_path);
+  const std::string metric = metric_name.empty() ? task.metric : metric_name;
+  setup.metric = parse_metric(metric, metric_name.empty() ? task.file + ": metric" : "--metric");
+  if (setup.metric == Metric::kShape)
+    throw UserError("--metric: the shape metric needs shape parameters (--vary shape)");
+  setup.options = options;
+  if (setup.options.variations == 0) setup.options.variations = task.variations;
+  if (!fs::exists(task.m0))
+    throw UserError(task.file + ": m0: " + task.m0 +
+                    " does not exist (create it with `diverse seed-motion " + task.name + "`)");
+  setup.evaluator = std::make_unique<TaskEvaluator>(std::move(task));
+  setup.m0 = setup.evaluator->load_parameters(setup.evaluator->task().m0);
+  return setup;
+}
+
+nlohmann::json run_json(const RunSetup& setup) {
+  return {{"format", kRunFormat},
+          {"version", kRunVersion},
+          {"diverse_version", DIVERSE_VERSION},
+          {"task_file", setup.task_path},
+          {"task_text", setup.task_text},
+          {"metric", to_string(setup.metric)},
+          {"options", to_json(setup.options)}};
+}
+
+int resolve_threads(int threads) {
+  if (threads < 0) throw UserError("--threads: expected an integer >= 0 (0 = one per core)");
+  return threads == 0 ? ThreadPool::hardware_threads() : threads;
+}
+
+// The optimization loop shared by start and resume: steps, checkpoints, progress, and
+// the outputs at the end.
+void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& problem,
+           DiversityOptimizer& optimizer, ThreadPool& pool, double wall_before,
+           double checkpoint_seconds, bool quiet, bool render) {
+  const auto started = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return wall_before +
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  };
+  auto write_checkpoint = [&] {
+    write_json_atomic(dir / "checkpoint.json", {{"format", kCheckpointFormat},
+                                                {"wall_seconds", elapsed()},
+                                                {"optimizer", optimizer.checkpoint()}});
+  };
+
+  std::FILE* sink = quiet ? nullptr : stderr;
+  std::unique_ptr<ProgressReporter> progress;
+  if (sink) {
+    progress = std::make_unique<ProgressReporter>(sink, setup.options.max_generations);
+    const int n = setup.options.variations;
+    optimizer.set_callback(
+        [&progress, n](const DiversityRecord& record) { progress->on_record(record, n); });
+  }
+
+  write_checkpoint();
+  auto last = std::chrono::steady_clock::now();
+  while (!optimizer.done()) {
+    optimizer.step();
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
+      write_checkpoint();
+      last = now;
+    }
+  }
+  write_checkpoint();
+  if (progress)
+    progress->finish("optimization ended (" + std::string(to_string(optimizer.stop_reason())) +
+                     ") after " + std::to_string(optimizer.generation()) + " generations, " +
+                     std::to_string(optimizer.evaluations()) + " evaluations");
+
+  RunOutputs outputs{dir, *setup.evaluator, problem, setup.m0, optimizer, pool};
+  outputs.wall_seconds = elapsed();
+  outputs.render = render;
+  write_run_outputs(outputs);
+  if (sink) std::fprintf(sink, "results in %s (summary.json, motions/, filmstrip.png)\n",
+                         dir.string().c_str());
+}
+
+bool holds_run(const fs::path& dir) {
+  return fs::exists(dir / "run.json") || fs::exists(dir / "checkpoint.json") ||
+         fs::exists(dir / "summary.json");
+}
+
+}  // namespace
+
+nlohmann::json without_timing(nlohmann::json summary) {
+  summary.erase("timing");
+  return summary;
+}
+
+void start_run(const RunRequest& request) {
+  const int threads = resolve_threads(request.threads);
+  try {
+    validate(request.options.variations == 0
+                 ? [&] { auto o = request.options; o.variations = 1; return o; }()
+                 : request.options);
+  } catch (const std::invalid_argument& e) {
+    throw UserError(e.what());
+  }
+  RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.options);
+
+  if (holds_run(request.out)) {
+    if (!request.force)
+      throw UserError(request.out.string() +
+                      ": already holds a run (use --force to replace it, or `diverse resume " +
+                      request.out.string() + "` to continue it)");
+    for (const char* name : {"run.json", "checkpoint.json", "summary.json", "log.jsonl",
+                             "filmstrip.png", "motions", "model", "paths"})
+      fs::remove_all(request.out / name);
+  }
+  ensure_writable_directory(request.out);
+  write_json_atomic(request.out / "run.json", run_json(setup));
+
+  ThreadPool pool(threads);
+  const MotionProblem problem(*setup.evaluator, setup.metric, setup.m0.normalized(), pool.size());
+  DiversityOptimizer optimizer(problem, setup.options, pool);
+  drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
+        request.quiet, request.render);
+}
+
+void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpoint_seconds,
+                bool render) {
+  const int threads = resolve_threads(threads_arg);
+  if (!fs::is_directory(dir)) throw UserError(dir.string() + ": not a directory");
+  if (!fs::exists(dir / "run.json"))
+    throw UserError(dir.string() + ": not a run directory (no run.json; start one with `diverse run`)");
+  const nlohmann::json run = read_json(dir / "run.json");
+  const std::string where = (dir / "run.json").string();
+  if (!run.is_object() || run.value("format", "") != kRunFormat)
+    throw UserError(where + ": format: expected \"" + kRunFormat + "\"");
+  RunSetup setup;
+  try {
+    const std::string task_file = run.at("task_file").get<std::string>();
+    const std::string task_text = run.at("task_text").get<std::string>();
+    if (!fs::exists(task_file))
+      throw UserError(where + ": task_file: " + task_file + " no longer exists");
+    if (read_file(task_file) != task_text)
+      throw UserError(task_file + ": changed since the run started; a resumed run must use the same task");
+    setup = make_setup(task_file, run.at("metric").get<std::string>(),
+                       diversity_options_from_json(run.at("options")));
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(where + ": expected the settings `diverse run` writes (" + e.what() + ")");
+  }
+
+  if (!fs::exists(dir / "checkpoint.json"))
+    throw UserError(dir.string() + ": no checkpoint.json to resume from");
+  const nlohmann::json checkpoint = read_json(dir / "checkpoint.json");
+  const std::string cwhere = (dir / "checkpoint.json").string();
+  if (!checkpoint.is_object() || checkpoint.value("format", "") != kCheckpointFormat ||
+      !checkpoint.contains("optimizer"))
+    throw UserError(cwhere + ": format: expected a checkpoint written by `diverse run`");
+
+  ThreadPool pool(threads);
+  const MotionProblem problem(*setup.evaluator, setup.metric, setup.m0.normalized(), pool.size());
+  std::unique_ptr<DiversityOptimizer> optimizer;
+  try {
+    optimizer = std::make_unique<DiversityOptimizer>(
+        DiversityOptimizer::from_checkpoint(problem, checkpoint.at("optimizer"), pool));
+  } catch (const UserError& e) {
+    throw UserError(cwhere + ": " + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(cwhere + ": corrupt checkpoint (" + std::string(e.what()) + ")");
+  } catch (const std::logic_error& e) {
+    throw UserError(cwhere + ": does not reproduce on this machine (" + std::string(e.what()) + ")");
+  }
+  const double wall_before = checkpoint.value("wall_seconds", 0.0);
+  drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render);
+}
+
+}  // namespace diverse

@@ -1,0 +1,55 @@
+// A diversity run of a task, on disk (SPEC section 7).
+//
+// `diverse run TASK --out DIR` and `diverse resume DIR` both end here. A run directory:
+//
+//   run.json            settings: task file (absolute path and its text), metric, the
+//                       optimizer's options, version
+//   checkpoint.json     the optimizer's complete state at a generation boundary, written
+//                       atomically (temp + rename) every few seconds and at the end
+//   log.jsonl           one JSON record per CMA step (generation, variation, D, C, dmin,
+//                       evaluations)
+//   paths/m<i>.json     variation i's optimization path: its mean after each of its steps,
+//                       as named controller parameters
+//   summary.json        the result (see write_summary), written when the run ends
+//   motions/m<i>.json   i = 0..N: parameters, phase boundaries, pose samples and the
+//                       exact-replay record; model/m<i>.xml is the model it replays on
+//   filmstrip.png       M0..MN at the same phase events, one row each
+//
+// Results never depend on the thread count or on interruptions: a run killed at any
+// moment and resumed from its checkpoint ends with the same summary.json as an
+// uninterrupted one, except for the "timing" object (wall time, threads).
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "optimize/diversity.h"
+
+namespace diverse {
+
+struct RunRequest {
+  std::string task;                 // task name or path (resolve_task_path)
+  std::string metric;               // "" = the task's metric
+  DiversityOptions options;         // variations = 0 means the task's N
+  std::filesystem::path out;        // run directory
+  int threads = 0;                  // 0 = one per core
+  bool force = false;               // replace an existing run in `out`
+  double checkpoint_seconds = 5.0;  // wall time between checkpoints
+  bool render = true;               // write filmstrip.png at the end
+  bool quiet = false;               // no progress output
+};
+
+// Starts a run. Throws UserError on bad input or if `out` holds a run and !force.
+void start_run(const RunRequest& request);
+
+// Continues the run in `dir` from its checkpoint (threads: 0 = one per core). A run that
+// already finished only has its outputs written again. Throws UserError if `dir` is not
+// a run directory, its checkpoint is corrupt, or its task file changed.
+void resume_run(const std::filesystem::path& dir, int threads, bool quiet = false,
+                double checkpoint_seconds = 5.0, bool render = true);
+
+// Removes the "timing" object: what must be identical between equivalent runs.
+nlohmann::json without_timing(nlohmann::json summary);
+
+}  // namespace diverse
