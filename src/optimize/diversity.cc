@@ -176,8 +176,9 @@ DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
   const int n = options_.variations;
   const int dim = problem_->dim();
   const Eigen::VectorXd p0 = problem_->reference();
-  if (dim < 1 || p0.size() != dim) {
-    throw std::logic_error("diversity: problem reference must have dim() >= 1 entries");
+  if (dim < 1 || p0.size() != dim || !(p0.array() >= 0.0).all() || !(p0.array() <= 1.0).all()) {
+    throw std::logic_error("diversity: the problem's reference must have dim() >= 1 entries, "
+                           "all in [0, 1]");
   }
 
   // Every variation starts at P_0, so all share M_0's outcome until they move.

@@ -263,61 +263,17 @@ struct OffscreenRenderer::Impl {
     }
   }
 
-  // Adds the overhead light when the model has none. Its shadow map covers a cylinder
-  // around the light ray through the centre of the bodies' current bounding box, just wide
-  // enough for the bodies: all their shadows fall inside it (the map is an orthographic
-  // projection along the light), and the small radius keeps the map's texels at 2-3 mm,
-  // free of the self-shadowing "acne" a map spread over the whole view shows on the floor.
-  void add_light(const SideCamera& camera) {
+  // Adds an overhead light when the model has none.
+  void add_light() {
     if (!style.add_light || copy->nlight > 0 || scene.nlight >= mjMAXLIGHT) return;
-    // Static scene objects in view (boxes, obstacles) are included, so their shadows do not
-    // come and go with the character's position.
-    const double half_view = camera.distance * std::tan(0.5 * camera.fovy * kDegree) *
-                             static_cast<double>(width) / height;
-    Bounds bodies;
-    for (int g = 0; g < copy->ngeom; ++g) {
-      if (copy->geom_group[g] > 2 || copy->geom_type[g] == mjGEOM_PLANE) continue;
-      if (copy->geom_bodyid[g] == 0 &&
-          std::abs(data->geom_xpos[3 * g] - camera.lookat[0]) > half_view) {
-        continue;
-      }
-      add_geom_bounds(copy.get(), data.get(), g, bodies);
-    }
-    // A map spread wider than about 2.2 mm per texel shows acne: then the static objects
-    // are left out and only the moving bodies get the map.
-    const double max_texel = 0.0022;  // m
-    const auto radius_of = [](const Bounds& b) {
-      double diagonal = 0.0;
-      for (int i = 0; i < 3; ++i) diagonal += (b.hi[i] - b.lo[i]) * (b.hi[i] - b.lo[i]);
-      return 0.5 * std::sqrt(diagonal) + 0.05;
-    };
-    if (!bodies.empty() && 2.0 * radius_of(bodies) / gl.shadowSize > max_texel) {
-      bodies = Bounds{};
-      for (int g = 0; g < copy->ngeom; ++g) {
-        if (copy->geom_bodyid[g] != 0 && copy->geom_group[g] <= 2) {
-          add_geom_bounds(copy.get(), data.get(), g, bodies);
-        }
-      }
-    }
-    std::array<double, 3> centre = camera.lookat;
-    double radius = 1.0;
-    if (!bodies.empty()) {
-      for (int i = 0; i < 3; ++i) centre[i] = 0.5 * (bodies.lo[i] + bodies.hi[i]);
-      radius = radius_of(bodies);
-    }
-    gl.shadowClip = static_cast<float>(radius);
-
     mjvLight& light = scene.lights[scene.nlight++];
     light = mjvLight{};
     // From above, in front of the character and to the left: the shadow falls on the floor
     // behind and to the right, where it shows contact and flight without hiding the feet.
     const std::array<double, 3> dir{0.3, 0.4, -1.0};
     const double norm = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-    // Far enough back that the near plane of the shadow projection misses the bodies.
-    const double back = radius + 0.2 * camera.distance + 2.0;
     for (int i = 0; i < 3; ++i) {
       light.dir[i] = static_cast<float>(dir[i] / norm);
-      light.pos[i] = static_cast<float>(centre[i] - back * dir[i] / norm);
       light.diffuse[i] = 0.5f;
       light.specular[i] = 0.2f;
     }
@@ -325,6 +281,55 @@ struct OffscreenRenderer::Impl {
     light.cutoff = 180.0f;
     light.directional = 1;
     light.castshadow = 1;
+  }
+
+  // MuJoCo maps the shadows of a directional light over a cylinder of radius shadowClip
+  // around the light's ray through its position. The ray is moved to pass through the
+  // centre of the bodies (and the static objects in view) in the current pose, and the
+  // radius is made just wide enough for them: all their shadows fall inside (the map is an
+  // orthographic projection along the light), shadows follow a character that travels, and
+  // the small radius keeps the map's texels at about 2 mm, free of the self-shadowing "acne"
+  // a map spread over the whole view shows on the floor.
+  void fit_shadows(const SideCamera& camera) {
+    const double half_view = camera.distance * std::tan(0.5 * camera.fovy * kDegree) *
+                             static_cast<double>(width) / height;
+    const auto region = [&](bool with_static) {
+      Bounds b;
+      for (int g = 0; g < copy->ngeom; ++g) {
+        if (copy->geom_group[g] > 2 || copy->geom_type[g] == mjGEOM_PLANE) continue;
+        if (copy->geom_bodyid[g] == 0 &&
+            (!with_static || std::abs(data->geom_xpos[3 * g] - camera.lookat[0]) > half_view)) {
+          continue;
+        }
+        add_geom_bounds(copy.get(), data.get(), g, b);
+      }
+      return b;
+    };
+    const auto radius_of = [](const Bounds& b) {
+      double diagonal = 0.0;
+      for (int i = 0; i < 3; ++i) diagonal += (b.hi[i] - b.lo[i]) * (b.hi[i] - b.lo[i]);
+      return 0.5 * std::sqrt(diagonal) + 0.05;
+    };
+    // Past about 2.2 mm per texel the floor shows acne: then only the moving bodies count.
+    constexpr double kMaxTexel = 0.0022;  // m
+    Bounds bodies = region(true);
+    if (!bodies.empty() && 2.0 * radius_of(bodies) / gl.shadowSize > kMaxTexel) {
+      bodies = region(false);
+    }
+    if (bodies.empty()) return;
+    std::array<double, 3> centre{};
+    for (int i = 0; i < 3; ++i) centre[i] = 0.5 * (bodies.lo[i] + bodies.hi[i]);
+    const double radius = radius_of(bodies);
+    gl.shadowClip = static_cast<float>(radius);
+    // Far enough back along the ray that the near plane of the projection misses the bodies.
+    const double back = radius + 0.2 * camera.distance + 2.0;
+    for (int i = 0; i < scene.nlight; ++i) {
+      mjvLight& light = scene.lights[i];
+      if (!light.directional || !light.castshadow || light.headlight) continue;
+      for (int k = 0; k < 3; ++k) {
+        light.pos[k] = static_cast<float>(centre[k] - back * light.dir[k]);
+      }
+    }
   }
 };
 
@@ -438,7 +443,8 @@ Image OffscreenRenderer::render(std::span<const double> qpos, const SideCamera& 
   cam.azimuth = camera.azimuth;
   cam.elevation = camera.elevation;
   mjv_updateScene(m, d, &r.option, nullptr, &cam, mjCAT_ALL, &r.scene);
-  r.add_light(camera);
+  r.add_light();
+  r.fit_shadows(camera);
   r.add_floor(camera);
   r.scene.flags[mjRND_SKYBOX] = 0;  // the sky is painted from the depth buffer below
   r.scene.flags[mjRND_SHADOW] = r.style.shadows ? 1 : 0;

@@ -115,7 +115,7 @@ struct RenderStyle {
   Rgb band_dark{198, 198, 196};
   bool add_light = true;  // add a shadow-casting overhead light if the model has no lights
   bool shadows = true;    // about half the cost of a picture (llvmpipe)
-  int shadow_size = 1536;  // px, side of the shadow map (the model's 4096 costs far more)
+  int shadow_size = 1024;  // px, side of the shadow map (the model's 4096 costs far more)
   int supersample = 2;     // render at this multiple of the size, then box-filter (1..4)
 };
 

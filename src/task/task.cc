@@ -231,7 +231,7 @@ void read_constraints(const Reader& r, Task& task) {
 
 void read_simulation(const Reader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
-          "clearance_range"});
+          "clearance_range", "timestep"});
   TaskSimulation& s = task.simulation;
   s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
   s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
@@ -239,6 +239,7 @@ void read_simulation(const Reader& r, Task& task) {
   s.max_time = r.number("max_time", 0.5, 60, s.max_time);
   s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
   s.clearance_range = r.number("clearance_range", 0.01, 2, s.clearance_range);
+  s.timestep = r.number("timestep", 0, 0.01, s.timestep);
 }
 
 void read_seed(const Reader& r, Task& task) {
@@ -348,6 +349,26 @@ std::string scene_xml(const Task& task) {
     throw UserError(task.character + ": expected a <worldbody> element in the model");
   }
   xml.insert(at, geoms.str());
+  if (task.simulation.timestep > 0) {
+    // Override the timestep attribute of <option> (added if the model has none).
+    std::ostringstream value;
+    value.precision(17);
+    value << task.simulation.timestep;
+    const size_t option = xml.find("<option");
+    if (option == std::string::npos) {
+      const size_t root = xml.find('>', xml.find("<mujoco"));
+      xml.insert(root + 1, "\n  <option timestep=\"" + value.str() + "\"/>");
+    } else {
+      const size_t end = xml.find('>', option);
+      const size_t attr = xml.find("timestep=\"", option);
+      if (attr != std::string::npos && attr < end) {
+        const size_t begin = attr + 10;
+        xml.replace(begin, xml.find('"', begin) - begin, value.str());
+      } else {
+        xml.insert(option + 7, " timestep=\"" + value.str() + "\"");
+      }
+    }
+  }
   return xml;
 }
 

@@ -64,6 +64,7 @@ struct TaskSimulation {
   double max_time = 6.0;          // s, hard cap of a rollout
   double fall_com_height = 0.3;   // m: COM closer than this to the feet's height = fall
   double clearance_range = 0.3;   // m: distance up to which obstacle proximity is seen
+  double timestep = 0;            // s; > 0 overrides the model's timestep
 };
 
 struct TaskSeed {

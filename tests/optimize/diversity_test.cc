@@ -164,6 +164,17 @@ TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
   EXPECT_THROW(validate(bad([](auto& b) { b.sigma0 = 0.0; })), std::invalid_argument);
   EXPECT_THROW(validate(bad([](auto& b) { b.max_generations = 0; })), std::invalid_argument);
   EXPECT_THROW(validate(bad([](auto& b) { b.window = -1; })), std::invalid_argument);
+  // The optimizer validates too, and checks the problem's reference is normalized.
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  EXPECT_THROW(DiversityOptimizer(problem, bad([](auto& b) { b.popsize = 0; }), pool),
+               std::invalid_argument);
+  struct OutOfRange : BallProblem {
+    OutOfRange() : BallProblem(2, 0.3) {}
+    Eigen::VectorXd reference() const override { return Eigen::Vector2d(0.5, 1.5); }
+  };
+  const OutOfRange out_of_range;
+  EXPECT_THROW(DiversityOptimizer(out_of_range, DiversityOptions{}, pool), std::logic_error);
   o.variations = 7;
   o.k = 3.25;
   o.strategy = DiversityStrategy::kJoint;

@@ -463,7 +463,9 @@ TEST(VideoTest, WritesEveryFrame) {
   EXPECT_EQ(writer.frames(), 10);
   ASSERT_TRUE(std::filesystem::exists(path));
   EXPECT_GT(std::filesystem::file_size(path), 0u);
-  if (have_ffprobe()) EXPECT_EQ(probe_frames(path), 10);
+  if (have_ffprobe()) {
+    EXPECT_EQ(probe_frames(path), 10);
+  }
 }
 
 TEST(VideoTest, SideBySideHoldsTheLastFrameOfShorterMotions) {
@@ -485,7 +487,9 @@ TEST(VideoTest, SideBySideHoldsTheLastFrameOfShorterMotions) {
   write_side_by_side_video(path, tracks, options);
   ASSERT_TRUE(std::filesystem::exists(path));
   EXPECT_GT(std::filesystem::file_size(path), 0u);
-  if (have_ffprobe()) EXPECT_EQ(probe_frames(path), 10);  // the longer track's length
+  if (have_ffprobe()) {
+    EXPECT_EQ(probe_frames(path), 10);  // the longer track's length
+  }
 
   EXPECT_THROW(write_side_by_side_video(path, {}, options), std::invalid_argument);
 }

@@ -1,0 +1,193 @@
+// Task files: the committed tasks parse; every kind of bad input is a one-line UserError
+// naming file, field and expectation; the constraint penalty follows SPEC 2.4.
+#include "task/task.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+#include "task/constraints.h"
+
+namespace diverse {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
+
+// A valid task file whose text the tests then break one way at a time.
+std::string valid_text() {
+  return "name = \"t\"\n"
+         "character = \"" + std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human2d.xml\"\n"
+         "metric = \"md\"\n"
+         "variations = 4\n"
+         "m0 = \"t.m0.json\"\n"
+         "[controller]\n"
+         "type = \"jump2d\"\n"
+         "[constraints]\n"
+         "weight = 5000.0\n"
+         "fall_penalty = 100000.0\n"
+         "landing = { center = 1.0, half_width = 0.15 }\n";
+}
+
+class TaskFileTest : public ::testing::Test {
+ protected:
+  std::string write(const std::string& text) {
+    const fs::path dir = fs::temp_directory_path() / ("diverse_task_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path p = dir / "t.toml";
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  std::string error_of(const std::string& text) {
+    const std::string path = write(text);
+    try {
+      load_task(path);
+    } catch (const UserError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+      EXPECT_EQ(message.rfind(path, 0), 0u) << message;  // starts with the file
+      return message.substr(path.size());
+    }
+    ADD_FAILURE() << "no error for:\n" << text;
+    return "";
+  }
+  static std::string replace(std::string text, const std::string& from, const std::string& to) {
+    text.replace(text.find(from), from.size(), to);
+    return text;
+  }
+};
+
+TEST_F(TaskFileTest, CommittedTasksParse) {
+  for (const char* name : {"backflip", "jump_forward", "jump_onto", "jump_over", "jump_high"}) {
+    const Task t = load_task(resolve_task_path(name));
+    EXPECT_EQ(t.name, name);
+    EXPECT_TRUE(fs::exists(t.character));
+    EXPECT_TRUE(fs::exists(t.m0)) << t.m0;
+    EXPECT_EQ(t.constraints.weight, 5000.0);
+    EXPECT_EQ(t.variations, 4);
+  }
+  EXPECT_EQ(load_task(kTasks + "backflip.toml").metric, "wja");
+  EXPECT_EQ(load_task(kTasks + "jump_forward.toml").metric, "md");
+  EXPECT_EQ(load_task(kTasks + "jump_onto.toml").metric, "wja");
+  EXPECT_EQ(load_task(kTasks + "jump_over.toml").metric, "wja");
+  EXPECT_EQ(load_task(kTasks + "jump_high.toml").metric, "md");
+  const Task onto = load_task(kTasks + "jump_onto.toml");
+  ASSERT_NE(onto.find_object("box"), nullptr);
+  EXPECT_DOUBLE_EQ(onto.find_object("box")->height, 0.5);
+  const Task over = load_task(kTasks + "jump_over.toml");
+  EXPECT_DOUBLE_EQ(over.find_object("obstacle")->height, 0.55);
+  EXPECT_TRUE(over.constraints.min_length);
+  EXPECT_TRUE(load_task(kTasks + "backflip.toml").constraints.rotation);
+  EXPECT_TRUE(load_task(kTasks + "jump_high.toml").constraints.peak_height);
+}
+
+TEST_F(TaskFileTest, ValidTextParses) {
+  const Task t = load_task(write(valid_text()));
+  EXPECT_EQ(t.name, "t");
+  EXPECT_TRUE(t.constraints.landing);
+  EXPECT_DOUBLE_EQ(t.constraints.landing_center, 1.0);
+  EXPECT_DOUBLE_EQ(t.simulation.settle_time, 1.0);
+}
+
+TEST_F(TaskFileTest, MissingField) {
+  EXPECT_EQ(error_of(replace(valid_text(), "metric = \"md\"\n", "")),
+            ": metric: expected a string (missing)");
+  EXPECT_EQ(error_of(replace(valid_text(), "weight = 5000.0\n", "")),
+            ": constraints.weight: expected a number in [1e-06, 1e+09] (missing)");
+}
+
+TEST_F(TaskFileTest, UnknownKey) {
+  const std::string e = error_of(replace(valid_text(), "[controller]\n", "[controller]\nspeed = 3\n"));
+  EXPECT_EQ(e.rfind(": controller.speed: expected no such key (unknown key; known keys: type,", 0), 0u) << e;
+  const std::string top = error_of(valid_text() + "[extra]\n");
+  EXPECT_EQ(top.rfind(": extra: expected no such key", 0), 0u) << top;
+}
+
+TEST_F(TaskFileTest, WrongType) {
+  EXPECT_EQ(error_of(replace(valid_text(), "variations = 4", "variations = \"four\"")),
+            ": variations: expected an integer in [1, 100]");
+  EXPECT_EQ(error_of(replace(valid_text(), "weight = 5000.0", "weight = \"big\"")),
+            ": constraints.weight: expected a number in [1e-06, 1e+09]");
+}
+
+TEST_F(TaskFileTest, OutOfRange) {
+  EXPECT_EQ(error_of(replace(valid_text(), "half_width = 0.15", "half_width = -1")),
+            ": constraints.landing.half_width: expected a number in [0.001, 10], got -1");
+  EXPECT_EQ(error_of(replace(valid_text(), "metric = \"md\"", "metric = \"xyz\"")),
+            ": metric: expected \"hf\", \"md\" or \"wja\", got \"xyz\"");
+}
+
+TEST_F(TaskFileTest, ModelPathMissing) {
+  const std::string e = error_of(replace(valid_text(), "human2d.xml", "nobody.xml"));
+  EXPECT_EQ(e.rfind(": character: expected an existing file (relative to the task file), but ", 0), 0u) << e;
+  EXPECT_NE(e.find("nobody.xml does not exist"), std::string::npos) << e;
+}
+
+TEST_F(TaskFileTest, MalformedToml) {
+  const std::string e = error_of(valid_text() + "this is = = not toml\n");
+  EXPECT_EQ(e.rfind(": line 12: expected valid TOML (", 0), 0u) << e;
+}
+
+TEST_F(TaskFileTest, ObjectReferences) {
+  const std::string e = error_of(valid_text() + "on_box = { object = \"crate\", margin = 0.1 }\n");
+  EXPECT_EQ(e, ": constraints.on_box.object: expected the name of an object of kind \"box\", got \"crate\"");
+}
+
+TEST_F(TaskFileTest, ResolveTaskPath) {
+  EXPECT_TRUE(fs::exists(resolve_task_path("backflip")));
+  try {
+    resolve_task_path("no_such_task");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "no_such_task: expected a task file or the name of one in tasks/ (no such task)");
+  }
+}
+
+TEST_F(TaskFileTest, SceneObjectsAndTimestepOverride) {
+  Task t = load_task(kTasks + "jump_onto.toml");
+  std::string xml = scene_xml(t);
+  EXPECT_NE(xml.find("<geom name=\"box\" type=\"box\""), std::string::npos);
+  t.simulation.timestep = 0.001;
+  xml = scene_xml(t);
+  EXPECT_NE(xml.find("timestep=\"0.001\""), std::string::npos);
+  EXPECT_EQ(xml.find("timestep=\"0.002\""), std::string::npos);
+}
+
+// C = 5000 |d|^2 outside the allowed region (SPEC 2.4), a large constant for a fall.
+TEST(Constraints, PenaltiesFollowSpec) {
+  Task t = load_task(kTasks + "jump_forward.toml");
+  MotionSummary m;
+  m.took_off = m.landed = m.settled = true;
+  m.fell = false;
+  m.feet_x = 1.0;
+  ConstraintReport r = evaluate_constraints(t, m);
+  EXPECT_EQ(r.total, 0.0);
+  m.feet_x = 1.0 + 0.15 + 0.1;  // 10 cm outside the box
+  r = evaluate_constraints(t, m);
+  EXPECT_NEAR(r.total, 5000 * 0.1 * 0.1, 1e-9);
+  m.fell = true;
+  m.fall_progress = 1;
+  r = evaluate_constraints(t, m);
+  EXPECT_NEAR(r.total, 100000 + 50, 1e-9);
+  EXPECT_TRUE(r.fell);
+  m.fall_progress = 0;  // falling at the very start costs twice the constant
+  EXPECT_NEAR(evaluate_constraints(t, m).total, 200000 + 50, 1e-9);
+  m.unstable = true;
+  EXPECT_NEAR(evaluate_constraints(t, m).total, 300000, 1e-9);
+
+  Task flip = load_task(kTasks + "backflip.toml");
+  MotionSummary f;
+  f.feet_x = flip.constraints.landing_center;
+  f.rotation_total = 2 * M_PI - 0.4;  // within the 0.5 rad tolerance
+  EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
+  f.rotation_total = 2 * M_PI - 0.7;  // 0.2 rad beyond it
+  EXPECT_NEAR(evaluate_constraints(flip, f).total, 100000 + 5000 * 0.04, 1e-6);
+  EXPECT_GT(constraint_margin(flip, MotionSummary{}), -2);  // defined everywhere
+}
+
+}  // namespace
+}  // namespace diverse
