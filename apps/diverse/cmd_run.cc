@@ -36,6 +36,7 @@ struct RunArgs {
   bool force = false;
   bool quiet = false;
   bool no_render = false;
+  double checkpoint_seconds = 5.0;
 };
 
 void install_run(CLI::App& app) {
@@ -65,6 +66,9 @@ void install_run(CLI::App& app) {
   cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
   cmd->add_flag("--quiet", args->quiet, "No progress output");
   cmd->add_flag("--no-render", args->no_render, "Do not write filmstrip.png");
+  cmd->add_option("--checkpoint-seconds", args->checkpoint_seconds,
+                  "Wall seconds between checkpoints (0 = every generation)")
+      ->capture_default_str();
   cmd->callback([args] {
     const RunArgs& a = *args;
     if (a.n < 0) throw UserError("--n: expected an integer >= 1, got " + std::to_string(a.n));
@@ -77,6 +81,8 @@ void install_run(CLI::App& app) {
       throw UserError("--sigma0: expected a number in (0, 1], got " + std::to_string(a.sigma0));
     if (a.window < 0) throw UserError("--window: expected an integer >= 0");
     if (!(a.epsilon >= 0.0)) throw UserError("--epsilon: expected a number >= 0");
+    if (!(a.checkpoint_seconds >= 0.0))
+      throw UserError("--checkpoint-seconds: expected a number >= 0");
     if (!a.metric.empty()) parse_metric(a.metric);
     RunRequest request;
     request.task = a.task;
@@ -94,6 +100,7 @@ void install_run(CLI::App& app) {
     request.force = a.force;
     request.quiet = a.quiet;
     request.render = !a.no_render;
+    request.checkpoint_seconds = a.checkpoint_seconds;
     std::string task_name = a.task;
     if (const auto slash = task_name.find_last_of('/'); slash != std::string::npos)
       task_name = task_name.substr(slash + 1);
@@ -108,11 +115,21 @@ void install_resume(CLI::App& app) {
   auto dir = std::make_shared<std::string>();
   auto threads = std::make_shared<int>(0);
   auto quiet = std::make_shared<bool>(false);
+  auto checkpoint_seconds = std::make_shared<double>(5.0);
+  auto no_render = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
   cmd->add_option("dir", *dir, "Run directory")->required();
   cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")->capture_default_str();
   cmd->add_flag("--quiet", *quiet, "No progress output");
-  cmd->callback([dir, threads, quiet] { resume_run(*dir, *threads, *quiet); });
+  cmd->add_flag("--no-render", *no_render, "Do not write filmstrip.png");
+  cmd->add_option("--checkpoint-seconds", *checkpoint_seconds,
+                  "Wall seconds between checkpoints (0 = every generation)")
+      ->capture_default_str();
+  cmd->callback([dir, threads, quiet, checkpoint_seconds, no_render] {
+    if (!(*checkpoint_seconds >= 0.0))
+      throw UserError("--checkpoint-seconds: expected a number >= 0");
+    resume_run(*dir, *threads, *quiet, *checkpoint_seconds, !*no_render);
+  });
 }
 
 const bool registered_run = register_command(30, install_run);

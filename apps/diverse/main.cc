@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
   CLI::App app{"diverse: diverse motions and character shapes for simulated skills"};
   app.set_version_flag("--version", std::string(DIVERSE_VERSION));
   app.require_subcommand(1);
+  // A flag given twice takes its last value, as in most command-line tools.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   auto commands = diverse::cli::registry();
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

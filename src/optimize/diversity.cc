@@ -232,6 +232,11 @@ void DiversityOptimizer::rescore() {
 
 bool DiversityOptimizer::step() {
   if (done()) return false;
+  struct InStep {
+    explicit InStep(bool& flag) : flag_(flag) { flag_ = true; }
+    ~InStep() { flag_ = false; }
+    bool& flag_;
+  } in_step(in_step_);
   ++generation_;
   switch (options_.strategy) {
     case DiversityStrategy::kRoundRobin:
@@ -416,6 +421,10 @@ DiversityResult DiversityOptimizer::result() const {
 }
 
 nlohmann::json DiversityOptimizer::checkpoint() const {
+  if (in_step_) {
+    throw std::logic_error("DiversityOptimizer::checkpoint: only between generations, not "
+                           "from inside step()");
+  }
   nlohmann::json j;
   j["format"] = kCheckpointFormat;
   j["version"] = kCheckpointVersion;

@@ -157,7 +157,8 @@ class DiversityOptimizer {
   // The best set so far (see the header comment).
   DiversityResult result() const;
 
-  // The complete state; call between step()s.
+  // The complete state, at a generation boundary: call it between step()s (it throws
+  // std::logic_error when called from the callback, in the middle of a generation).
   nlohmann::json checkpoint() const;
 
  private:
@@ -200,6 +201,7 @@ class DiversityOptimizer {
   long long phase_budget_ = 0;
   // Variation whose new mean awaits evaluation (0 = none); always 0 between generations.
   int pending_ = 0;
+  bool in_step_ = false;
 
   std::vector<DiversityRecord> log_;
   std::vector<std::vector<PathPoint>> paths_;

@@ -45,6 +45,19 @@ void record_damping(const mjModel* m, int step, StepRecorder* r) {
   r->damping.push_back(std::move(change));
 }
 
+// True if any damped dof's damping differs from `last`, which is then updated.
+bool damping_changed(const mjModel* m, const std::vector<int>& dofs, std::vector<double>* last) {
+  bool changed = false;
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    const double v = m->dof_damping[dofs[k]];
+    if (v != (*last)[k]) {
+      (*last)[k] = v;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
 }  // namespace
 
 RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
@@ -54,6 +67,8 @@ RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
   RolloutStats stats;
   if (recorder != nullptr) start_record(m, d, damped_dofs, recorder);
   std::string error;
+  std::vector<double> last_damping;
+  for (int dof : damped_dofs) last_damping.push_back(m->dof_damping[dof]);
   for (int step = 0; step < max_steps; ++step) {
     if (!guarded_step1(m, d, &error)) {
       stats.unstable = true;
@@ -61,6 +76,10 @@ RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
       break;
     }
     hooks.control(m, d);
+    // mj_step1 computed the passive (damping) forces with the damping of the previous
+    // step; the hooks may have changed it. Recompute them so that this step is exactly
+    // what mj_step does with the new damping (and so replays bit for bit).
+    if (damping_changed(m, damped_dofs, &last_damping)) mj_passive(m, d);
     if (hooks.observe(m, d)) break;
     if (recorder != nullptr) {
       record_damping(m, step, recorder);

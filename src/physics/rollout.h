@@ -1,10 +1,11 @@
 // The rollout loop: control, observe, step, until the outcome is decided.
 //
 // Each step runs mj_step1 (kinematics, contacts and velocities of the current state),
-// then the hooks' control() writes d->ctrl (and the worker's dof_damping), observe()
-// decides whether to stop, and mj_step2 integrates. mj_step1 + mj_step2 computes exactly
-// what mj_step does with the same inputs, so a recorded rollout replays bit for bit with
-// plain mj_step (see replay()).
+// then the hooks' control() writes d->ctrl (and the worker's dof_damping; if it changed,
+// the passive forces mj_step1 computed are recomputed with mj_passive), observe() decides
+// whether to stop, and mj_step2 integrates. This computes exactly what mj_step does with
+// the same inputs, so a recorded rollout replays bit for bit with plain mj_step (see
+// replay()).
 //
 // A rollout that goes unstable (a MuJoCo warning, a non-finite state, or a MuJoCo error
 // caught by the guard) stops and reports it; it never throws or aborts.

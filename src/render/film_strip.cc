@@ -56,7 +56,8 @@ Image render_film_strip(std::span<const FilmRow> rows, const FilmStripOptions& o
   const int n_rows = static_cast<int>(rows.size());
   const int grid_x = options.margin + label_w;
   const int grid_y = options.margin + title_h + header_h;
-  const int width = grid_x + n_cols * tile_w + std::max(n_cols - 1, 0) * options.gap +
+  const int width = std::max(grid_x + n_cols * tile_w + std::max(n_cols - 1, 0) * options.gap,
+                             grid_x + text_width(options.title, kTitleFont)) +
                     options.margin;
   const int height = grid_y + n_rows * tile_h + std::max(n_rows - 1, 0) * options.gap +
                      options.margin;

@@ -32,30 +32,34 @@ void check_qpos(const mjModel* model, std::size_t size) {
   }
 }
 
-// World-frame corners of the box bounding one geom, given its pose in `data`.
+// Grows `bounds` by the world-axis-aligned box around one geom in its pose in `data`:
+// exact for spheres, capsules, cylinders, boxes and ellipsoids, the bounding sphere else.
 void add_geom_bounds(const mjModel* m, const mjData* d, int g, Bounds& bounds) {
   const mjtNum* p = d->geom_xpos + 3 * g;
-  const mjtNum* R = d->geom_xmat + 9 * g;  // row-major; column k is the geom's k-th axis
+  const mjtNum* R = d->geom_xmat + 9 * g;  // row-major: R[3 * i + k] = axis k's world i
   const mjtNum* s = m->geom_size + 3 * g;
-  std::array<double, 3> half{};  // half extent along the geom's own axes
-  bool oriented = true;
-  switch (m->geom_type[g]) {
-    case mjGEOM_SPHERE: half = {s[0], s[0], s[0]}; break;
-    case mjGEOM_CAPSULE: half = {s[0], s[0], s[1] + s[0]}; break;
-    case mjGEOM_CYLINDER: half = {s[0], s[0], s[1]}; break;
-    case mjGEOM_BOX: half = {s[0], s[1], s[2]}; break;
-    default: oriented = false; break;
-  }
-  for (int axis = 0; axis < 3; ++axis) {
+  for (int i = 0; i < 3; ++i) {
+    const double* row = R + 3 * i;
     double extent = m->geom_rbound[g];
-    if (oriented) {
-      extent = 0.0;
-      for (int k = 0; k < 3; ++k) extent += std::abs(R[3 * axis + k]) * half[k];
+    switch (m->geom_type[g]) {
+      case mjGEOM_SPHERE: extent = s[0]; break;
+      case mjGEOM_CAPSULE: extent = std::abs(row[2]) * s[1] + s[0]; break;
+      case mjGEOM_CYLINDER:
+        extent = std::abs(row[2]) * s[1] + s[0] * std::sqrt(std::max(0.0, 1.0 - row[2] * row[2]));
+        break;
+      case mjGEOM_BOX:
+        extent = std::abs(row[0]) * s[0] + std::abs(row[1]) * s[1] + std::abs(row[2]) * s[2];
+        break;
+      case mjGEOM_ELLIPSOID:
+        extent = std::sqrt(row[0] * row[0] * s[0] * s[0] + row[1] * row[1] * s[1] * s[1] +
+                           row[2] * row[2] * s[2] * s[2]);
+        break;
+      default: break;
     }
     std::array<double, 3> lo{p[0], p[1], p[2]};
     std::array<double, 3> hi = lo;
-    lo[axis] -= extent;
-    hi[axis] += extent;
+    lo[i] -= extent;
+    hi[i] += extent;
     bounds.add(lo);
     bounds.add(hi);
   }
@@ -135,7 +139,9 @@ SideCamera fit_side_camera(const Bounds& bounds, double aspect, const SideCamera
     for (int i = 0; i < 3; ++i) {
       q[i] = ((corner >> i & 1) ? bounds.hi[i] : bounds.lo[i]) - camera.lookat[i];
     }
-    auto dot = [&q](const std::array<double, 3>& v) { return q[0] * v[0] + q[1] * v[1] + q[2] * v[2]; };
+    auto dot = [&q](const std::array<double, 3>& v) {
+      return q[0] * v[0] + q[1] * v[1] + q[2] * v[2];
+    };
     distance = std::max(distance, std::abs(dot(right)) / tan_h - dot(forward));
     distance = std::max(distance, std::abs(dot(up)) / tan_v - dot(forward));
   }
@@ -185,6 +191,20 @@ struct OffscreenRenderer::Impl {
   std::vector<unsigned char> rgb;  // supersampled picture, bottom row first
   std::vector<float> depth;
   float clear_depth = 1.0f;  // depth where nothing was drawn (1 in MuJoCo 2.2; 0 if reverse-Z)
+  bool scene_made = false;
+  bool gl_made = false;
+
+  // Frees MuJoCo's GL resources inside their own context, then the context; also after a
+  // constructor that failed part way.
+  ~Impl() {
+    if (context == nullptr) return;
+    if (gl_made && OSMesaMakeCurrent(context, window.data(), GL_UNSIGNED_BYTE, 1, 1)) {
+      mjr_freeContext(&gl);
+    }
+    if (scene_made) mjv_freeScene(&scene);
+    OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+    OSMesaDestroyContext(context);
+  }
 
   void make_current() {
     if (!OSMesaMakeCurrent(context, window.data(), GL_UNSIGNED_BYTE, 1, 1)) {
@@ -383,15 +403,13 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
   for (int i = 0; i < mjNGROUP; ++i) r.option.sitegroup[i] = 0;  // sites are markers, not bodies
   mjv_defaultScene(&r.scene);
   mjv_makeScene(m, &r.scene, m->ngeom + m->nsite + kMaxDecorGeoms);
+  r.scene_made = true;
   mjr_defaultContext(&r.gl);
-  mjr_makeContext(m, &r.gl, mjFONTSCALE_50);
+  mjr_makeContext(m, &r.gl, mjFONTSCALE_50);  // fonts unused: labels are drawn on the CPU
+  r.gl_made = true;
   mjr_setBuffer(mjFB_OFFSCREEN, &r.gl);
   if (r.gl.currentBuffer != mjFB_OFFSCREEN || r.gl.offWidth < width * ss ||
       r.gl.offHeight < height * ss) {
-    mjr_freeContext(&r.gl);
-    mjv_freeScene(&r.scene);
-    OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
-    OSMesaDestroyContext(r.context);
     throw std::runtime_error("render: MuJoCo could not create its offscreen framebuffer");
   }
   // Read the depth an empty picture leaves, rather than assume MuJoCo's depth convention.
@@ -410,15 +428,7 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
   r.depth.resize(static_cast<std::size_t>(width) * height * ss * ss);
 }
 
-OffscreenRenderer::~OffscreenRenderer() {
-  Impl& r = *impl_;
-  if (OSMesaMakeCurrent(r.context, r.window.data(), GL_UNSIGNED_BYTE, 1, 1)) {
-    mjr_freeContext(&r.gl);
-  }
-  mjv_freeScene(&r.scene);
-  OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
-  OSMesaDestroyContext(r.context);
-}
+OffscreenRenderer::~OffscreenRenderer() = default;
 
 Image OffscreenRenderer::render(std::span<const double> qpos, const SideCamera& camera) {
   Impl& r = *impl_;
@@ -457,9 +467,9 @@ Image OffscreenRenderer::render(std::span<const double> qpos, const SideCamera& 
   mjr_render(viewport, &r.scene, &r.gl);
   mjr_readPixels(r.rgb.data(), r.depth.data(), viewport, &r.gl);
 
-  // Paint the sky where nothing was drawn (depth still at its cleared value), from sky_top at the top of the picture to
-  // sky_bottom at the horizon (the lowest row with sky), then average ss x ss samples per
-  // pixel. GL rows run bottom-up; the image's run top-down.
+  // Paint the sky where nothing was drawn (the depth is still at its cleared value), from
+  // sky_top at the top of the picture to sky_bottom at the horizon (the lowest row with
+  // sky), then average ss x ss samples per pixel. GL rows run bottom-up, the image's down.
   int horizon = 0;  // supersampled rows from the top
   for (int row = 0; row < H; ++row) {
     const float* line = r.depth.data() + static_cast<std::size_t>(row) * W;

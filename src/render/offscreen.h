@@ -1,30 +1,35 @@
 // Offscreen rendering of MuJoCo models on machines with no display and no GPU.
 //
-// Choice of GL: OSMesa (Mesa's off-screen interface, package libosmesa6-dev) with the
-// llvmpipe software rasterizer. It needs no X server, no DISPLAY, no GPU and no environment
-// variables, and one context per renderer is created with a single call; EGL's surfaceless
-// platform also works on Mesa but must be selected with EGL_PLATFORM=surfaceless and goes
-// through libglvnd's vendor selection, two more ways to fail on a user's machine. MuJoCo
-// (libmujoco does not link GL) loads its GL entry points from whatever context is current
-// when mjr_makeContext runs, so a context is made current first (MuJoCo's `record` sample
-// does the same with -DMJ_OSMESA). See docs/rendering.md for costs.
+// GL: OSMesa (Mesa's off-screen interface, Debian package libosmesa6-dev) with the llvmpipe
+// software rasterizer. It needs no X server, no DISPLAY, no GPU and no environment variable,
+// and a context is one call. EGL's surfaceless platform also works on Mesa, but has to be
+// chosen with EGL_PLATFORM=surfaceless and goes through libglvnd's vendor selection: two
+// more ways to fail on a user's machine for no gain in software. libmujoco does not link GL;
+// it loads its GL entry points from the context current when mjr_makeContext runs, so the
+// context is made current first (as MuJoCo's `record` sample does with -DMJ_OSMESA). Costs
+// are measured in docs/rendering.md.
 //
-// Pictures: MuJoCo 2.2.2 renders into an offscreen framebuffer of the size given by the
-// model's <visual><global offwidth offheight>; the renderer keeps its own copy of the model
-// with that size (and the camera's field of view, near/far planes and headlight) set for the
-// picture, so any model works. The scene is drawn at `supersample` times the requested size
-// without multisampling, the empty background (depth buffer still at its cleared value) is
-// replaced by
-// a sky gradient, and the result is box-filtered down: edges are smooth and silhouettes blend
-// with the sky rather than with the GL clear colour. Floor bands (alternating tones every
-// `band_width` along x) make travelled distance readable; ground strips mark x-intervals
-// such as a landing region. Body colours are the model's geom rgba and materials.
+// Each renderer keeps its own copy of the model, adjusted for pictures: MuJoCo 2.2.2 draws
+// offscreen into a framebuffer sized by <visual><global offwidth offheight>, so the copy
+// gets the picture's size (any model works, whatever it sets); the camera's field of view
+// and near/far planes follow the camera; the headlight is set for an even look; built-in
+// meshes are coarser (vertices dominate llvmpipe's cost). The caller's model is untouched.
 //
-// Threads: a GL context can be current on only one thread at a time, and MuJoCo's renderer
-// keeps its state in that context. An OffscreenRenderer must therefore be used by one thread
-// at a time; render() makes its own context current on the calling thread, so several
+// The look, chosen to read well on screen and in print: the scene is drawn at `supersample`
+// times the picture size without multisampling; where nothing was drawn (the depth buffer
+// still at its cleared value) a sky gradient is painted; the result is box-filtered down,
+// so edges are smooth and silhouettes blend with the sky rather than the GL clear colour.
+// The model's floor plane is replaced by a plain light floor with a track along x whose tone
+// alternates every `band_width`, so travelled distance can be read; ground strips mark
+// x-intervals such as a landing region. A model without lights gets one overhead light;
+// directional lights cast shadows mapped around the bodies in each picture (see
+// fit_shadows in offscreen.cc). Body colours are the model's geom rgba and materials.
+//
+// Threads: a GL context can be current on only one thread at a time, and MuJoCo keeps its
+// renderer state in that context. An OffscreenRenderer must therefore be used by one thread
+// at a time. render() makes its own context current on the calling thread, so several
 // renderers may take turns on one thread, and distinct renderers may run on distinct threads
-// concurrently.
+// at once (each owns its context, scene and mjData).
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -66,8 +71,9 @@ struct Bounds {
 };
 
 // Box around the visible geoms (groups 0-2) of every body except the world body, over all
-// frames (each a qpos of size model->nq; throws std::invalid_argument otherwise). Capsules,
-// cylinders, boxes and spheres are bounded exactly, other shapes by their bounding sphere.
+// frames (each a qpos of size model->nq; throws std::invalid_argument otherwise). Spheres,
+// capsules, cylinders, boxes and ellipsoids are bounded exactly, meshes and other shapes by
+// their bounding sphere.
 Bounds pose_bounds(const mjModel* model, std::span<const std::vector<double>> frames);
 
 // Height (m) of the model's floor: the first plane geom of the world body whose normal
@@ -113,16 +119,17 @@ struct RenderStyle {
   double band_width = 0.5;        // m, along world x
   Rgb band_light{222, 222, 220};
   Rgb band_dark{198, 198, 196};
-  bool add_light = true;  // add a shadow-casting overhead light if the model has no lights
-  bool shadows = true;    // about half the cost of a picture (llvmpipe)
-  int shadow_size = 1024;  // px, side of the shadow map (the model's 4096 costs far more)
-  int supersample = 2;     // render at this multiple of the size, then box-filter (1..4)
+  bool add_light = true;    // add a shadow-casting overhead light if the model has none
+  bool shadows = true;      // about 3/4 of a picture's cost with llvmpipe
+  int shadow_size = 1024;   // px, side of the shadow map (the model's 4096 costs far more)
+  int supersample = 2;      // render at this multiple of the size, then box-filter (1..4)
 };
 
 class OffscreenRenderer {
  public:
   // Pictures of width x height pixels of `model`, which must outlive the renderer. Throws
-  // std::runtime_error if no GL context can be created (see docs/rendering.md).
+  // std::invalid_argument on a bad size or supersample, std::runtime_error if no GL context
+  // can be created (see docs/rendering.md).
   OffscreenRenderer(const mjModel* model, int width, int height, RenderStyle style = {});
   ~OffscreenRenderer();
   OffscreenRenderer(const OffscreenRenderer&) = delete;

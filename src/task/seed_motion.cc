@@ -23,7 +23,11 @@ struct Scored {
   bool fell = true;
 };
 
-Scored score(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worker) {
+// Scores x on the task, and, when it meets the task, again with the timestep halved:
+// a motion counts as meeting the task only if it does so at both timesteps, which keeps
+// input motions away from knife-edge landings that depend on integration details.
+Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::VectorXd& x,
+             SimWorker& worker, SimWorker& fine_worker) {
   EvaluationOptions options;
   options.samples_per_phase = 0;
   const Evaluation e = ev.evaluate_normalized(x, worker, options);
@@ -31,9 +35,21 @@ Scored score(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worke
   s.constraint = e.constraint;
   s.fell = e.fell;
   s.margin = e.failed ? -1 : constraint_margin(ev.task(), e.summary);
-  const double reward = e.constraint == 0 ? std::min(std::max(s.margin, 0.0), kMarginCap) : 0;
-  s.f = e.constraint - ev.task().seed.robustness * reward;
+  if (e.constraint == 0) {
+    const Evaluation f = fine.evaluate_normalized(x, fine_worker, options);
+    s.constraint = f.constraint;
+    s.fell = f.fell;
+    s.margin = std::min(s.margin, f.failed ? -1 : constraint_margin(fine.task(), f.summary));
+  }
+  const double reward = s.constraint == 0 ? std::min(std::max(s.margin, 0.0), kMarginCap) : 0;
+  s.f = s.constraint - ev.task().seed.robustness * reward;
   return s;
+}
+
+Task halved(const Task& task, const mjModel* m) {
+  Task t = task;
+  t.simulation.timestep = 0.5 * m->opt.timestep;
+  return t;
 }
 
 Task with_height(const Task& task, double height) {
@@ -61,10 +77,14 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     const bool last = stage + 1 == heights.size();
     const Task stage_task = heights[stage] < 0 ? task : with_height(task, heights[stage]);
     const TaskEvaluator ev(stage_task);
-    std::vector<std::unique_ptr<SimWorker>> workers;
-    for (int w = 0; w < pool.size(); ++w) workers.push_back(ev.make_worker());
+    const TaskEvaluator fine(halved(stage_task, ev.model().get()));
+    std::vector<std::unique_ptr<SimWorker>> workers, fine_workers;
+    for (int w = 0; w < pool.size(); ++w) {
+      workers.push_back(ev.make_worker());
+      fine_workers.push_back(fine.make_worker());
+    }
 
-    Scored best = score(ev, x, *workers[0]);
+    Scored best = score(ev, fine, x, *workers[0], *fine_workers[0]);
     Eigen::VectorXd best_x = x;
     ++result.evaluations;
     if (options.log) {
@@ -89,7 +109,8 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       const std::vector<Eigen::VectorXd>& xs = es.ask();
       std::vector<Scored> scores(xs.size());
       pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
-        scores[k] = score(ev, xs[k], *workers[static_cast<std::size_t>(worker)]);
+        const auto w = static_cast<std::size_t>(worker);
+        scores[k] = score(ev, fine, xs[k], *workers[w], *fine_workers[w]);
       });
       std::vector<double> f(xs.size());
       bool improved = false;
@@ -121,8 +142,10 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
 
   // The result on the full task.
   const TaskEvaluator ev(task);
+  const TaskEvaluator fine(halved(task, ev.model().get()));
   auto worker = ev.make_worker();
-  const Scored final_score = score(ev, x, *worker);
+  auto fine_worker = fine.make_worker();
+  const Scored final_score = score(ev, fine, x, *worker, *fine_worker);
   result.parameters.set_normalized(x);
   result.constraint = final_score.constraint;
   result.margin = final_score.margin;

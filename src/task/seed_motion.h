@@ -10,7 +10,10 @@
 // is the penalty alone (margin < 0 is clipped to 0 there); inside it a small reward for
 // slack prefers input motions that land near the middle of their box or clear their
 // obstacle with room, so the diversity optimizer starts from a motion with margin.
-// With robustness = 0 this is the penalty alone.
+// With robustness = 0 this is the penalty alone. A candidate that meets the task is
+// simulated again with the timestep halved and counts as meeting it only if it does so
+// there too (C is then the larger of the two), so input motions do not hinge on
+// integration details.
 //
 // Deterministic for a given task seed: CMA-ES draws from seeds derived from it, and the
 // generation's samples are evaluated in parallel into fixed slots.

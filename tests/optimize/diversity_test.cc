@@ -202,7 +202,10 @@ TEST(DiversityRoundRobin, OneGenerationStepsEveryVariationInTurn) {
   const DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 5);
   DiversityOptimizer opt(problem, o, pool);
   int callbacks = 0;
-  opt.set_callback([&](const DiversityRecord&) { ++callbacks; });
+  opt.set_callback([&](const DiversityRecord&) {
+    ++callbacks;
+    EXPECT_THROW(opt.checkpoint(), std::logic_error);  // mid-generation
+  });
   opt.run();
   EXPECT_EQ(opt.stop_reason(), DiversityStop::kMaxGenerations);
   EXPECT_EQ(opt.generation(), 5);

@@ -11,6 +11,7 @@
 
 #include "physics/model.h"
 #include "physics/mujoco_guard.h"
+#include "core/error.h"
 #include "task/evaluate.h"
 
 namespace diverse {

@@ -43,7 +43,8 @@ constexpr char kTinyModel[] = R"(
         <body name="shin_r" pos="0 0 -0.45">
           <joint name="knee_r" type="hinge" axis="0 1 0"/>
           <geom type="capsule" fromto="0 0 0 0 0 -0.42" size="0.05" rgba="0.85 0.35 0.3 1"/>
-          <geom type="capsule" fromto="-0.04 0 -0.45 0.14 0 -0.45" size="0.04" rgba="0.3 0.3 0.3 1"/>
+          <geom type="capsule" fromto="-0.04 0 -0.45 0.14 0 -0.45" size="0.04"
+                rgba="0.3 0.3 0.3 1"/>
         </body>
       </body>
       <body name="thigh_l" pos="0 0.06 0">
@@ -52,7 +53,8 @@ constexpr char kTinyModel[] = R"(
         <body name="shin_l" pos="0 0 -0.45">
           <joint name="knee_l" type="hinge" axis="0 1 0"/>
           <geom type="capsule" fromto="0 0 0 0 0 -0.42" size="0.05" rgba="0.55 0.25 0.25 1"/>
-          <geom type="capsule" fromto="-0.04 0 -0.45 0.14 0 -0.45" size="0.04" rgba="0.2 0.2 0.2 1"/>
+          <geom type="capsule" fromto="-0.04 0 -0.45 0.14 0 -0.45" size="0.04"
+                rgba="0.2 0.2 0.2 1"/>
         </body>
       </body>
     </body>
@@ -166,8 +168,9 @@ TEST(ImageTest, PngRoundTripIsExact) {
   Image image(5, 3);
   for (int y = 0; y < 3; ++y) {
     for (int x = 0; x < 5; ++x) {
-      image.set_pixel(x, y, Rgb{static_cast<std::uint8_t>(50 * x), static_cast<std::uint8_t>(80 * y),
-                                static_cast<std::uint8_t>(x * y)});
+      image.set_pixel(x, y,
+                      Rgb{static_cast<std::uint8_t>(50 * x), static_cast<std::uint8_t>(80 * y),
+                          static_cast<std::uint8_t>(x * y)});
     }
   }
   write_png(dir.file("a.png"), image);
@@ -255,12 +258,28 @@ TEST(CameraTest, PoseBoundsAreExactForCapsulesAndSpheres) {
   EXPECT_THROW(pose_bounds(model.get(), wrong), std::invalid_argument);
 }
 
+TEST(CameraTest, PoseBoundsAreExactForATiltedCapsule) {
+  const ModelPtr model = load_model(
+      R"(<mujoco><worldbody><body pos="0 0 1"><joint type="hinge" axis="0 1 0"/>
+         <geom type="capsule" fromto="0 0 0 0 0 0.5" size="0.1"/></body></worldbody></mujoco>)");
+  const double angle = 0.7;  // rad about +y: the capsule's far end tips towards +x
+  const std::vector<std::vector<double>> frames = {{angle}};
+  const Bounds b = pose_bounds(model.get(), frames);
+  // The capsule's box is its end points' box grown by its radius.
+  EXPECT_NEAR(b.lo[0], -0.1, 1e-9);
+  EXPECT_NEAR(b.hi[0], 0.5 * std::sin(angle) + 0.1, 1e-9);
+  EXPECT_NEAR(b.lo[2], 1.0 - 0.1, 1e-9);
+  EXPECT_NEAR(b.hi[2], 1.0 + 0.5 * std::cos(angle) + 0.1, 1e-9);
+  EXPECT_NEAR(b.hi[1], 0.1, 1e-9);
+}
+
 TEST(CameraTest, FloorHeightComesFromTheWorldPlane) {
   const ModelPtr model = load_model(kTinyModel);
   ASSERT_TRUE(floor_height(model.get()).has_value());
   EXPECT_EQ(*floor_height(model.get()), 0.0);
   const ModelPtr no_floor = load_model(
-      R"(<mujoco><worldbody><body><joint type="slide" axis="1 0 0"/><geom size="0.1"/></body></worldbody></mujoco>)");
+      R"(<mujoco><worldbody><body><joint type="slide" axis="1 0 0"/><geom size="0.1"/></body>
+         </worldbody></mujoco>)");
   EXPECT_FALSE(floor_height(no_floor.get()).has_value());
 }
 
@@ -475,7 +494,8 @@ TEST(VideoTest, SideBySideHoldsTheLastFrameOfShorterMotions) {
     tracks[k].model = model.get();
     tracks[k].label = "M" + std::to_string(k);
     for (int t = 0; t < 6 + 4 * k; ++t) {
-      tracks[k].frames.push_back({0.05 * t, 0.1 * t * (k + 1), 0.0, -0.1 * t, 0.2 * t, 0.1 * t, 0.0});
+      tracks[k].frames.push_back(
+          {0.05 * t, 0.1 * t * (k + 1), 0.0, -0.1 * t, 0.2 * t, 0.1 * t, 0.0});
     }
   }
   SideBySideOptions options;

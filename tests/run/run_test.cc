@@ -1,0 +1,183 @@
+// End-to-end tests of `diverse run` and `diverse resume` on a short run of a real task:
+// thread-count independence, exact resume after kill -9, and the errors users meet.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "io/files.h"
+#include "io/motion_record.h"
+#include "run/run.h"
+
+namespace diverse {
+namespace {
+namespace fs = std::filesystem;
+
+struct Result {
+  int status = -1;
+  std::string output;
+};
+
+Result run_cli(const std::string& args) {
+  const std::string command = std::string(DIVERSE_BINARY) + " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (pipe && fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
+  const int status = pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("diverse_run_test_" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+const std::string kTask = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_forward.toml";
+// Short but real: 2 variations, 8 samples per generation, 5 generations.
+const std::string kShort = kTask + " --n 2 --popsize 8 --generations 5 --seed 3 --quiet --no-render";
+
+TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
+  const fs::path one = scratch("threads1"), two = scratch("threads2");
+  Result a = run_cli("run " + kShort + " --threads 1 --out " + one.string());
+  ASSERT_EQ(a.status, 0) << a.output;
+  Result b = run_cli("run " + kShort + " --threads 2 --out " + two.string());
+  ASSERT_EQ(b.status, 0) << b.output;
+  const auto sa = read_json(one / "summary.json");
+  const auto sb = read_json(two / "summary.json");
+  EXPECT_EQ(sa["timing"]["threads"], 1);
+  EXPECT_EQ(sb["timing"]["threads"], 2);
+  EXPECT_EQ(without_timing(sa), without_timing(sb));
+  EXPECT_EQ(read_file(one / "log.jsonl"), read_file(two / "log.jsonl"));
+
+  // The run directory holds what SPEC section 7 lists.
+  EXPECT_EQ(sa["N"], 2);
+  EXPECT_EQ(sa["motions"].size(), 3u);
+  for (const char* metric : {"hf", "md", "wja"}) EXPECT_EQ(sa["distances"][metric].size(), 3u);
+  for (int i = 0; i <= 2; ++i) {
+    const fs::path motion = one / "motions" / ("m" + std::to_string(i) + ".json");
+    ASSERT_TRUE(fs::exists(motion));
+    ASSERT_TRUE(fs::exists(one / "model" / ("m" + std::to_string(i) + ".xml")));
+    // Every exported motion replays exactly in plain MuJoCo.
+    int steps = 0;
+    EXPECT_LT(replay_motion_file(motion, &steps), 1e-6) << motion;
+    EXPECT_GT(steps, 100);
+  }
+  EXPECT_TRUE(fs::exists(one / "paths" / "m1.json"));
+  EXPECT_TRUE(fs::exists(one / "checkpoint.json"));
+  // M0 is the committed input motion: it satisfies its task.
+  EXPECT_EQ(sa["motions"][0]["constraint"], 0.0);
+}
+
+TEST(Run, ResumeAfterKillGivesTheSameSummary) {
+  const fs::path whole = scratch("whole"), killed = scratch("killed");
+  const std::string args = kShort + " --generations 6 --threads 1 --checkpoint-seconds 0";
+  Result a = run_cli("run " + args + " --out " + whole.string());
+  ASSERT_EQ(a.status, 0) << a.output;
+
+  // Start the same run and kill -9 it once a checkpoint past generation 2 exists.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string command = std::string(DIVERSE_BINARY) + " run " + args + " --out " +
+                                killed.string() + " >/dev/null 2>&1";
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  long long generation = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
+  while (generation < 2 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (fs::exists(killed / "checkpoint.json")) {
+      try {
+        generation = read_json(killed / "checkpoint.json")["optimizer"]["generation"].get<long long>();
+      } catch (...) {
+        // Never torn (atomic rename); a read racing the rename may see it missing.
+      }
+    }
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_GE(generation, 2);
+  ASSERT_FALSE(fs::exists(killed / "summary.json")) << "the run finished before it was killed";
+
+  Result r = run_cli("resume " + killed.string() + " --threads 2 --quiet --no-render");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(without_timing(read_json(whole / "summary.json")),
+            without_timing(read_json(killed / "summary.json")));
+  EXPECT_EQ(read_file(whole / "log.jsonl"), read_file(killed / "log.jsonl"));
+}
+
+TEST(RunErrors, OneLineMessagesAndNonZeroExit) {
+  const fs::path out = scratch("errors");
+  struct Case {
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {"run no_such_task --out " + out.string(), "no_such_task"},
+      {"run " + kTask + " --n -1 --out " + out.string(), "--n: expected an integer >= 1"},
+      {"run " + kTask + " --k -2 --out " + out.string(), "--k: expected a number >= 0"},
+      {"run " + kTask + " --generations 0 --out " + out.string(), "--generations: expected an integer >= 1"},
+      {"run " + kTask + " --strategy sideways --out " + out.string(), "sideways"},
+      {"run " + kTask + " --metric euclid --out " + out.string(), "--metric: unknown metric 'euclid'"},
+      {"resume " + out.string() + "/nowhere", "not a directory"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const Result r = run_cli(c.args);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << "expected one line: " << r.output;
+    EXPECT_EQ(r.output.rfind("diverse: error: ", 0), 0u) << r.output;
+  }
+}
+
+TEST(RunErrors, ResumeRefusesADirectoryThatIsNotARun) {
+  const fs::path dir = scratch("notarun");
+  fs::create_directories(dir);
+  const Result r = run_cli("resume " + dir.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("not a run directory"), std::string::npos) << r.output;
+}
+
+TEST(RunErrors, CorruptCheckpointAndExistingRun) {
+  const fs::path dir = scratch("corrupt");
+  Result a = run_cli("run " + kShort + " --generations 1 --threads 2 --out " + dir.string());
+  ASSERT_EQ(a.status, 0) << a.output;
+  const std::string summary = read_file(dir / "summary.json");
+
+  // An existing run is never overwritten without --force.
+  Result again = run_cli("run " + kShort + " --generations 1 --out " + dir.string());
+  EXPECT_NE(again.status, 0);
+  EXPECT_NE(again.output.find("already holds a run (use --force"), std::string::npos) << again.output;
+  EXPECT_EQ(read_file(dir / "summary.json"), summary);
+
+  // A truncated checkpoint is reported, not trusted.
+  const std::string checkpoint = read_file(dir / "checkpoint.json");
+  write_file_atomic(dir / "checkpoint.json", checkpoint.substr(0, checkpoint.size() / 2));
+  Result r = run_cli("resume " + dir.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("checkpoint.json: not valid JSON"), std::string::npos) << r.output;
+
+  // A checkpoint of another shape is reported too.
+  write_file_atomic(dir / "checkpoint.json", "{\"format\": \"something else\"}");
+  r = run_cli("resume " + dir.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("checkpoint.json: format"), std::string::npos) << r.output;
+
+  // --force replaces the run.
+  Result forced = run_cli("run " + kShort + " --generations 1 --force --out " + dir.string());
+  EXPECT_EQ(forced.status, 0) << forced.output;
+}
+
+}  // namespace
+}  // namespace diverse
