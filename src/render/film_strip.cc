@@ -90,7 +90,7 @@ Image render_film_strip(std::span<const FilmRow> rows, const FilmStripOptions& o
     for (int c = 0; c < n_cols; ++c) {
       const int x = grid_x + c * (tile_w + options.gap);
       canvas.fill_rect(x - 1, y - 1, tile_w + 2, tile_h + 2, options.tile_border);
-      if (c < static_cast<int>(row.frames.size())) {
+      if (c < static_cast<int>(row.frames.size()) && !row.frames[c].empty()) {
         canvas.paste(renderer->render(row.frames[c], camera), x, y);
       } else {
         canvas.fill_rect(x, y, tile_w, tile_h, options.background);

@@ -24,7 +24,9 @@ namespace diverse {
 struct FilmRow {
   const mjModel* model = nullptr;
   std::string label;                        // drawn left of the row, e.g. "M0"
-  std::vector<std::vector<double>> frames;  // one qpos (size model->nq) per column
+  // One qpos (size model->nq) per column; an empty qpos leaves that tile empty (e.g. a
+  // motion that never reached the column's phase event).
+  std::vector<std::vector<double>> frames;
 };
 
 struct FilmStripOptions {

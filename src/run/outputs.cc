@@ -54,17 +54,18 @@ FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
   };
   const PhaseTimes& p = e.phases;
   const double end = record.steps() * dt;
+  // Every motion gets every column, so columns line up across rows; an event the motion
+  // never reached leaves its tile empty.
   auto add = [&](const std::string& name, double t) {
-    if (t < 0) return;
     columns.names.push_back(name);
-    columns.frames.push_back(frame_at(t));
+    columns.frames.push_back(t < 0 ? std::vector<double>() : frame_at(t));
   };
   add("crouch", p.begin[kCrouch]);
   add("extend", p.begin[kExtend]);
   add("take-off", p.takeoff());
-  if (p.takeoff() >= 0 && p.peak() >= 0) add("rising", 0.5 * (p.takeoff() + p.peak()));
+  add("rising", p.takeoff() >= 0 && p.peak() >= 0 ? 0.5 * (p.takeoff() + p.peak()) : -1);
   add("peak", p.peak());
-  if (p.peak() >= 0 && p.landing() >= 0) add("falling", 0.5 * (p.peak() + p.landing()));
+  add("falling", p.peak() >= 0 && p.landing() >= 0 ? 0.5 * (p.peak() + p.landing()) : -1);
   add("touch-down", p.landing());
   add("end", end);
   return columns;
