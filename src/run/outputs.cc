@@ -1,8 +1,10 @@
 #include "run/outputs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "core/rng.h"
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/model.h"
@@ -110,6 +112,22 @@ void write_run_outputs(const RunOutputs& o) {
     distances[to_string(metric)] = matrix_json(d);
   }
 
+  // The scale of "different": the mean distance between M0 and M0 nudged by 0.01 (in
+  // normalized parameter units, 4 fixed draws). Variations should be far above it.
+  constexpr int kNudges = 4;
+  std::vector<double> nudge_distance(kNudges, 0.0);
+  const Eigen::VectorXd x0 = result.parameters[0];
+  o.pool.parallel_for(kNudges, [&](std::size_t k, int worker) {
+    Rng rng(derive_seed(options.seed, {0x6e75646765ULL, k}));
+    Eigen::VectorXd x = x0;
+    for (Eigen::Index j = 0; j < x.size(); ++j)
+      x[j] = std::clamp(x[j] + 0.01 * rng.normal(), 0.0, 1.0);
+    const auto nudged = o.problem.evaluate(x, worker);
+    nudge_distance[k] = is_failure(*nudged) ? 0.0 : o.problem.distance(*result.outcomes[0], *nudged);
+  });
+  double nudge_mean = 0;
+  for (double d : nudge_distance) nudge_mean += d / kNudges;
+
   // Motion files (re-simulated with recording on) and the film strip rows.
   fs::create_directories(o.dir / "motions");
   fs::create_directories(o.dir / "model");
@@ -158,6 +176,7 @@ void write_run_outputs(const RunOutputs& o) {
       {"all_satisfied", (result.score.constraint.array() == 0.0).all()},
       {"motions", motions},
       {"distances", distances},
+      {"nudged_m0_distance", nudge_mean},
       {"timing",
        {{"wall_seconds", o.wall_seconds},
         {"threads", o.pool.size()},
