@@ -14,18 +14,18 @@ namespace {
 
 const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
-struct Run {
+struct SimRun {
   Evaluation e;
   StepRecorder record;
 };
 
-Run simulate(const std::string& name, double timestep = 0) {
+SimRun simulate(const std::string& name, double timestep = 0) {
   Task task = load_task(kTasks + name + ".toml");
   task.simulation.timestep = timestep;
   const TaskEvaluator ev(task);
   const ParameterSet p = ev.load_parameters(task.m0);
   auto worker = ev.make_worker();
-  Run r;
+  SimRun r;
   EvaluationOptions options;
   options.recorder = &r.record;
   r.e = ev.evaluate(p.values(), *worker, options);
@@ -47,7 +47,7 @@ Run simulate(const std::string& name, double timestep = 0) {
 class M0 : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(M0, MeetsItsTask) {
-  const Run r = simulate(GetParam());
+  const SimRun r = simulate(GetParam());
   const Evaluation& e = r.e;
   EXPECT_FALSE(e.failed) << e.failure;
   EXPECT_FALSE(e.fell) << e.summary.fall_reason;
@@ -59,8 +59,8 @@ TEST_P(M0, MeetsItsTask) {
 }
 
 TEST_P(M0, TimestepHalvedLandsNearby) {
-  const Run a = simulate(GetParam());
-  const Run b = simulate(GetParam(), 0.001);
+  const SimRun a = simulate(GetParam());
+  const SimRun b = simulate(GetParam(), 0.001);
   EXPECT_NEAR(a.e.summary.feet_x, b.e.summary.feet_x, 0.05) << GetParam();
   EXPECT_FALSE(b.e.fell) << b.e.summary.fall_reason;
 }
@@ -70,7 +70,7 @@ INSTANTIATE_TEST_SUITE_P(Tasks, M0,
                                            "jump_high"));
 
 TEST(M0Specifics, BackflipTurnsOnce) {
-  const Run r = simulate("backflip");
+  const SimRun r = simulate("backflip");
   // A full backward turn between take-off and touch-down, give or take the lean of the
   // body at those instants, and one turn at rest.
   EXPECT_GT(r.e.summary.rotation_flight, 1.5 * M_PI);
@@ -78,7 +78,7 @@ TEST(M0Specifics, BackflipTurnsOnce) {
 }
 
 TEST(M0Specifics, JumpOntoStandsOnTheBox) {
-  const Run r = simulate("jump_onto");
+  const SimRun r = simulate("jump_onto");
   const Task task = load_task(kTasks + "jump_onto.toml");
   const SceneObject* box = task.find_object("box");
   EXPECT_GT(r.e.summary.feet_x, box->x_min + 0.1);
@@ -87,7 +87,7 @@ TEST(M0Specifics, JumpOntoStandsOnTheBox) {
 }
 
 TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
-  const Run r = simulate("jump_over");
+  const SimRun r = simulate("jump_over");
   EXPECT_GE(r.e.summary.min_clearance, 0.02);
   EXPECT_GE(r.e.summary.feet_x, 1.0);
 }
