@@ -35,8 +35,8 @@ ParamSpec pose_spec(int phase, int type) {
       {-0.5, 2.4}, {-2.6, 0.0}, {-0.9, 0.7}, {-0.7, 0.4},
       {-0.7, 0.4}, {-1.0, 3.1}, {0.0, 2.6},  {-1.2, 1.2}};
   static constexpr double kStance[kPoseTypes][2] = {
-      {-1.4, 0.6}, {-2.6, 0.0}, {-1.0, 0.4}, {-0.7, 0.4},
-      {-1.4, 0.8}, {-1.0, 3.1}, {0.0, 2.6},  {-1.2, 1.2}};
+      {-1.4, 1.4}, {-2.6, 0.0}, {-1.0, 0.4}, {-0.7, 0.4},
+      {-1.4, 1.4}, {-1.0, 3.1}, {0.0, 2.6},  {-1.2, 1.2}};
   const auto& r = is_stance(phase) ? kStance[type] : kFlight[type];
   return {pose_name(phase, type), r[0], r[1], "rad"};
 }
@@ -259,6 +259,9 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
       break;
     case kRise:
       if (contacts.any) {
+        // Touched down while still rising (a low, flat jump): the peak and the landing
+        // coincide, a zero-length fall, so every jump has both airborne phases.
+        times_.begin[kFall] = t;
         enter(kLand, t, m);
       } else if (com_vel_[2] <= 0) {
         enter(kFall, t, m);

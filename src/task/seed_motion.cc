@@ -23,24 +23,23 @@ struct Scored {
   bool fell = true;
 };
 
-// Scores x on the task, and, when it meets the task, again with the timestep halved:
-// a motion counts as meeting the task only if it does so at both timesteps, which keeps
-// input motions away from knife-edge landings that depend on integration details.
+// Scores x on the task at its timestep and again with the timestep halved, and sums the
+// two constraint values: a motion counts as meeting the task only if it does so at both
+// timesteps, which keeps input motions away from knife-edge landings that depend on
+// integration details. The sum (rather than checking the fine timestep only once the
+// coarse one is met) keeps the landscape graded for CMA-ES: a candidate that meets the
+// task coarsely but falls finely is ranked among the falls by how early it fell.
 Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::VectorXd& x,
              SimWorker& worker, SimWorker& fine_worker) {
   EvaluationOptions options;
   options.samples_per_phase = 0;
   const Evaluation e = ev.evaluate_normalized(x, worker, options);
+  const Evaluation f = fine.evaluate_normalized(x, fine_worker, options);
   Scored s;
-  s.constraint = e.constraint;
-  s.fell = e.fell;
-  s.margin = e.failed ? -1 : constraint_margin(ev.task(), e.summary);
-  if (e.constraint == 0) {
-    const Evaluation f = fine.evaluate_normalized(x, fine_worker, options);
-    s.constraint = f.constraint;
-    s.fell = f.fell;
-    s.margin = std::min(s.margin, f.failed ? -1 : constraint_margin(fine.task(), f.summary));
-  }
+  s.constraint = e.constraint + f.constraint;
+  s.fell = e.fell || f.fell;
+  s.margin = std::min(e.failed ? -1 : constraint_margin(ev.task(), e.summary),
+                      f.failed ? -1 : constraint_margin(fine.task(), f.summary));
   const double reward = s.constraint == 0 ? std::min(std::max(s.margin, 0.0), kMarginCap) : 0;
   s.f = s.constraint - ev.task().seed.robustness * reward;
   return s;
