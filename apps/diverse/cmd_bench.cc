@@ -18,7 +18,7 @@ namespace {
 
 void install_bench(CLI::App& app) {
   struct Args {
-    std::string task = "backflip";
+    std::string task = "jump_high";
     double seconds = 2.0;
     int threads = 0;
     bool json = false;

@@ -17,7 +17,7 @@
 namespace diverse::cli {
 namespace {
 
-constexpr const char* kDefaultTask = "backflip";
+constexpr const char* kDefaultTask = "jump_high";
 
 struct RunArgs {
   std::string task = kDefaultTask;
@@ -42,7 +42,7 @@ struct RunArgs {
 void install_run(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Find N diverse variations of a task's input motion (default task: backflip)");
+      "run", "Find N diverse variations of a task's input motion (default task: jump_high)");
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or path to a task file")
       ->capture_default_str();
   cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)");

@@ -41,7 +41,7 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-const std::string kTask = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_forward.toml";
+const std::string kTask = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml";
 // Short but real: 2 variations, 8 samples per generation, 5 generations.
 const std::string kShort = kTask + " --n 2 --popsize 8 --generations 5 --seed 3 --quiet --no-render";
 

@@ -4,6 +4,8 @@
 // moves each landing spot by only a few centimetres.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <cmath>
 #include <string>
 
@@ -44,9 +46,20 @@ SimRun simulate(const std::string& name, double timestep = 0) {
   return r;
 }
 
+// A task whose input motion has not been found yet has no m0 file; its checks are
+// reported as skipped (visible in the test output), never as passed.
+bool has_m0(const std::string& name) {
+  return std::filesystem::exists(load_task(kTasks + name + ".toml").m0);
+}
+#define REQUIRE_M0(name)                                                              \
+  if (!has_m0(name))                                                                  \
+  GTEST_SKIP() << "no committed input motion for " << (name)                          \
+               << " yet: find it with `diverse seed-motion " << (name) << "`"
+
 class M0 : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(M0, MeetsItsTask) {
+  REQUIRE_M0(GetParam());
   const SimRun r = simulate(GetParam());
   const Evaluation& e = r.e;
   EXPECT_FALSE(e.failed) << e.failure;
@@ -59,6 +72,7 @@ TEST_P(M0, MeetsItsTask) {
 }
 
 TEST_P(M0, TimestepHalvedLandsNearby) {
+  REQUIRE_M0(GetParam());
   const SimRun a = simulate(GetParam());
   const SimRun b = simulate(GetParam(), 0.001);
   EXPECT_NEAR(a.e.summary.feet_x, b.e.summary.feet_x, 0.05) << GetParam();
@@ -70,6 +84,7 @@ INSTANTIATE_TEST_SUITE_P(Tasks, M0,
                                            "jump_high"));
 
 TEST(M0Specifics, BackflipTurnsOnce) {
+  REQUIRE_M0("backflip");
   const SimRun r = simulate("backflip");
   // A full backward turn between take-off and touch-down, give or take the lean of the
   // body at those instants, and one turn at rest.
@@ -78,6 +93,7 @@ TEST(M0Specifics, BackflipTurnsOnce) {
 }
 
 TEST(M0Specifics, JumpOntoStandsOnTheBox) {
+  REQUIRE_M0("jump_onto");
   const SimRun r = simulate("jump_onto");
   const Task task = load_task(kTasks + "jump_onto.toml");
   const SceneObject* box = task.find_object("box");
@@ -87,12 +103,14 @@ TEST(M0Specifics, JumpOntoStandsOnTheBox) {
 }
 
 TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
+  REQUIRE_M0("jump_over");
   const SimRun r = simulate("jump_over");
   EXPECT_GE(r.e.summary.min_clearance, 0.02);
   EXPECT_GE(r.e.summary.feet_x, 1.0);
 }
 
 TEST(M0Specifics, JumpHighPeaksHighEnough) {
+  REQUIRE_M0("jump_high");
   EXPECT_GE(simulate("jump_high").e.summary.peak_com_z, 1.20);
 }
 

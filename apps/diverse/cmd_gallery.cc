@@ -1,0 +1,47 @@
+// `diverse gallery RUN [--no-paths] [--threads N]`: one self-contained HTML page,
+// RUN/gallery.html, with all motions of a finished run side by side in 3D, their
+// constraint values and distances, and each variation's optimization path. Opens from disk
+// in any browser, without network. See render/gallery.h and docs/viewing-results.md.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "command.h"
+#include "core/error.h"
+#include "render/gallery.h"
+
+namespace diverse::cli {
+namespace {
+
+struct GalleryArgs {
+  std::string run;
+  bool no_paths = false;
+  int threads = 0;
+};
+
+void install(CLI::App& app) {
+  auto args = std::make_shared<GalleryArgs>();
+  CLI::App* cmd = app.add_subcommand("gallery", "Interactive 3D gallery of a finished run (one HTML file)");
+  cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
+  cmd->add_flag("--no-paths", args->no_paths,
+                "Leave out the optimization paths (they are simulated from the run's task file)");
+  cmd->add_option("--threads", args->threads, "Simulation threads (0 = one per core)")
+      ->capture_default_str();
+  cmd->callback([args] {
+    if (args->threads < 0) throw UserError("--threads: expected 0 or more, got " + std::to_string(args->threads));
+    GalleryOptions options;
+    options.paths = !args->no_paths;
+    options.threads = args->threads;
+    const std::filesystem::path page = write_gallery(args->run, options);
+    std::printf("%s  (%.1f MB; open it in a browser)\n", page.string().c_str(),
+                static_cast<double>(std::filesystem::file_size(page)) / 1e6);
+  });
+}
+
+const bool registered = register_command(61, install);
+
+}  // namespace
+}  // namespace diverse::cli
