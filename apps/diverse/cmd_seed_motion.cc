@@ -10,6 +10,7 @@
 #include <string>
 
 #include "command.h"
+#include "io/files.h"
 #include "core/error.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
@@ -38,7 +39,19 @@ void run(const SeedArgs& args) {
   options.generations = args.generations;
   options.log = [](const std::string& line) { std::printf("%s\n", line.c_str()); std::fflush(stdout); };
   const SeedResult r = seed_motion(task, start, options);
-  const std::string out = args.out.empty() ? task.m0 : args.out;
+  // The task's m0 file only ever holds a motion that meets the task; a search that falls
+  // short writes its best attempt beside it, to continue from with --start.
+  const bool met = r.constraint == 0;
+  std::string out = args.out;
+  if (out.empty()) {
+    out = task.m0;
+    if (!met) {
+      const std::string suffix = ".m0.json";
+      out = out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0
+                ? out.substr(0, out.size() - suffix.size()) + ".partial.json"
+                : out + ".partial";
+    }
+  }
   nlohmann::json j;
   j["task"] = task.name;
   j["constraint"] = r.constraint;
@@ -46,11 +59,13 @@ void run(const SeedArgs& args) {
   j["found_by"] = "diverse seed-motion " + task.name + " (from " + start_path + ", " +
                   std::to_string(r.evaluations) + " rollouts)";
   j["parameters"] = r.parameters.to_json();
-  std::ofstream file(out);
-  if (!file) throw UserError(out + ": cannot write the parameter file");
-  file << std::setprecision(17) << j.dump(1) << "\n";
+  write_json_atomic(out, j);
   std::printf("C=%.6g margin=%.3f fell=%d evaluations=%lld seconds=%.1f -> %s\n", r.constraint,
               r.margin, r.fell ? 1 : 0, r.evaluations, r.seconds, out.c_str());
+  if (!met)
+    throw UserError(task.file + ": no motion meeting the task was found (best C = " +
+                    std::to_string(r.constraint) + "); continue with `diverse seed-motion " +
+                    task.name + " --start " + out + "`");
 }
 
 void install(CLI::App& app) {
