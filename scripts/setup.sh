@@ -6,7 +6,12 @@ packages=(
   libmujoco-dev libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libosmesa6-dev ffmpeg fonts-dejavu-core
+  chromium
 )
+# The gallery page (web/) is built with node and npm and tested in Chromium; a node that is
+# already installed (with its own npm) is used as it is.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,457 @@
+#include "render/gallery.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <unistd.h>
+
+#include "core/error.h"
+#include "core/thread_pool.h"
+#include "eval/motion_problem.h"
+#include "io/files.h"
+#include "metric/metric.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+
+// Where the build put the page template (set for this file by the top-level CMakeLists).
+#ifndef DIVERSE_GALLERY_TEMPLATE
+#define DIVERSE_GALLERY_TEMPLATE ""
+#endif
+
+namespace diverse {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kPlaceholder = "__DIVERSE_GALLERY_DATA__";
+
+// 4 decimals: 0.1 mm for positions, 1e-4 for unit quaternions and colours.
+double round4(double v) {
+  const double r = std::round(v * 1e4) / 1e4;
+  return r == 0.0 ? 0.0 : r;  // no "-0.0"
+}
+
+nlohmann::json rounded(const double* v, int n) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) a.push_back(round4(v[i]));
+  return a;
+}
+nlohmann::json rounded(const float* v, int n) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) a.push_back(round4(static_cast<double>(v[i])));
+  return a;
+}
+
+const char* geom_type_name(int type) {
+  switch (type) {
+    case mjGEOM_PLANE: return "plane";
+    case mjGEOM_HFIELD: return "hfield";
+    case mjGEOM_SPHERE: return "sphere";
+    case mjGEOM_CAPSULE: return "capsule";
+    case mjGEOM_ELLIPSOID: return "ellipsoid";
+    case mjGEOM_CYLINDER: return "cylinder";
+    case mjGEOM_BOX: return "box";
+    case mjGEOM_MESH: return "mesh";
+    default: return "other";
+  }
+}
+
+nlohmann::json geom_json(const mjModel* m, int g) {
+  // A material's colour wins over the geom's, as MuJoCo draws it.
+  const float* rgba = m->geom_matid[g] >= 0 ? m->mat_rgba + 4 * m->geom_matid[g] : m->geom_rgba + 4 * g;
+  return {{"type", geom_type_name(m->geom_type[g])},
+          {"size", rounded(m->geom_size + 3 * g, 3)},
+          {"body", m->geom_bodyid[g] - 1},  // -1: the world (scene objects)
+          {"pos", rounded(m->geom_pos + 3 * g, 3)},
+          {"quat", rounded(m->geom_quat + 4 * g, 4)},
+          {"rgba", rounded(rgba, 4)}};
+}
+
+bool on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return false;
+  const std::string paths = path;
+  std::size_t start = 0;
+  while (start <= paths.size()) {
+    const std::size_t end = std::min(paths.find(':', start), paths.size());
+    const std::string dir = paths.substr(start, end - start);
+    if (!dir.empty() && access((dir + "/" + program).c_str(), X_OK) == 0) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+std::string stem(char prefix, std::size_t i) {
+  std::string s(1, prefix);
+  s.append(std::to_string(i));
+  return s;
+}
+
+// Adds `model` to the page's models unless an identical one is there; returns its index.
+int add_model(nlohmann::json& models, const mjModel* model) {
+  nlohmann::json j = model_json(model);
+  for (std::size_t i = 0; i < models.size(); ++i)
+    if (models[i] == j) return static_cast<int>(i);
+  models.push_back(std::move(j));
+  return static_cast<int>(models.size()) - 1;
+}
+
+// Named parameters from a path or motion file. A value written from a normalized
+// coordinate of exactly 0 or 1 can miss its bound by a rounding error (lower + 1 * (upper -
+// lower) != upper); such values are put back on the bound before the strict check.
+ParameterSet named_parameters(const TaskEvaluator& evaluator, nlohmann::json values,
+                              const std::string& origin) {
+  ParameterSet set = evaluator.parameters();
+  if (values.is_object()) {
+    for (const ParamSpec& spec : set.specs()) {
+      auto it = values.find(spec.name);
+      if (it == values.end() || !it->is_number()) continue;
+      const double v = it->get<double>();
+      const double slack = 1e-9 * std::abs(spec.upper - spec.lower);
+      if (v > spec.upper && v <= spec.upper + slack) *it = spec.upper;
+      if (v < spec.lower && v >= spec.lower - slack) *it = spec.lower;
+    }
+  }
+  set.set_from_json(values, origin);
+  return set;
+}
+
+ParameterSet motion_parameters(const TaskEvaluator& evaluator, const fs::path& motion_file) {
+  const nlohmann::json motion = read_json(motion_file);
+  if (!motion.is_object() || !motion.contains("parameters"))
+    throw_field_error(motion_file.string(), "parameters", "the motion's named controller parameters");
+  return named_parameters(evaluator, motion["parameters"], motion_file.string());
+}
+
+// One point of a variation's path: its parameters and where it comes from.
+struct PathPoint {
+  Eigen::VectorXd x;     // normalized parameters
+  int generation = -1;
+  int step = -1;
+  bool result = false;   // the variation's result (motions/m<i>.json)
+};
+
+std::vector<PathPoint> read_path(const RunView& run, std::size_t variation,
+                                 const TaskEvaluator& evaluator) {
+  const fs::path file = run.dir / "paths" / (stem('m', variation) + ".json");
+  if (!fs::exists(file))
+    throw UserError(file.string() + ": missing; the run directory is incomplete (`diverse resume " +
+                    run.dir.string() + "` writes its outputs again)");
+  const nlohmann::json path = read_json(file);
+  if (!path.is_object() || !path.contains("points") || !path["points"].is_array())
+    throw_field_error(file.string(), "points", "a list of path points");
+  std::vector<PathPoint> points;
+  for (std::size_t k = 0; k < path["points"].size(); ++k) {
+    const nlohmann::json& p = path["points"][k];
+    const std::string field = "points[" + std::to_string(k) + "]";
+    if (!p.is_object() || !p.contains("parameters"))
+      throw_field_error(file.string(), field, "an object with \"parameters\"");
+    const ParameterSet set = named_parameters(evaluator, p["parameters"], file.string() + ": " + field);
+    points.push_back({set.normalized(), p.value("generation", -1), p.value("step", -1), false});
+  }
+  const ParameterSet result = motion_parameters(evaluator, run.motions[variation].file);
+  points.push_back({result.normalized(), -1, -1, true});
+  return points;
+}
+
+// The path points' data: distances from M0 of (up to max_path_candidates of) every path's
+// points, the picked points simulated again with recording on.
+nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nlohmann::json& models) {
+  const fs::path run_file = run.dir / "run.json";
+  const std::string task_file = run.run.value("task_file", std::string());
+  const std::string what = " the optimization paths cannot be simulated (restore it, or make "
+                           "the gallery with --no-paths)";
+  if (task_file.empty() || !fs::exists(task_file))
+    throw UserError(run_file.string() + ": task_file: " + task_file + " is missing;" + what);
+  if (read_file(task_file) != run.run.value("task_text", std::string()))
+    throw UserError(run_file.string() + ": task_file: " + task_file + " changed since the run;" + what);
+  const TaskEvaluator evaluator(load_task(task_file));
+  const Metric metric = parse_metric(run.metric, (run.dir / "summary.json").string() + ": metric");
+  const ParameterSet m0 = motion_parameters(evaluator, run.motions[0].file);
+
+  const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
+  const MotionProblem problem(evaluator, metric, m0.normalized(), threads);
+  ThreadPool pool(threads);
+
+  // Which points of each path are simulated to measure distances: all, or evenly spaced.
+  const std::size_t variations = run.motions.size() - 1;
+  std::vector<std::vector<PathPoint>> paths(variations + 1);
+  std::vector<std::vector<int>> candidates(variations + 1);
+  struct Job {
+    std::size_t variation = 0;
+    int point = 0;
+  };
+  std::vector<Job> jobs;
+  for (std::size_t v = 1; v <= variations; ++v) {
+    paths[v] = read_path(run, v, evaluator);
+    const int n = static_cast<int>(paths[v].size());
+    const int want = std::max(2, options.max_path_candidates);
+    for (int k = 0; k < std::min(n, want); ++k) {
+      const int index = n <= want ? k : static_cast<int>(std::lround(static_cast<double>(k) * (n - 1) / (want - 1)));
+      if (candidates[v].empty() || candidates[v].back() != index) candidates[v].push_back(index);
+    }
+    for (int index : candidates[v]) jobs.push_back({v, index});
+  }
+  std::vector<std::shared_ptr<const Outcome>> outcomes(jobs.size() + 1);
+  pool.parallel_for(jobs.size() + 1, [&](std::size_t j, int worker) {
+    outcomes[j] = j == 0 ? problem.evaluate(problem.reference(), worker)
+                         : problem.evaluate(paths[jobs[j - 1].variation][static_cast<std::size_t>(jobs[j - 1].point)].x, worker);
+  });
+  const Outcome& reference = *outcomes[0];
+
+  // Per variation, the picked points.
+  struct Pick {
+    std::size_t variation = 0;
+    int point = 0;
+    double fraction = 0;
+    double distance = 0;
+    const Outcome* outcome = nullptr;
+    nlohmann::json frames;
+    int model = 0;
+    double duration = 0;
+  };
+  std::vector<Pick> picks;
+  std::vector<double> end_distance(variations + 1, 0.0);
+  std::vector<bool> by_index(variations + 1, false);
+  std::size_t job = 1;
+  for (std::size_t v = 1; v <= variations; ++v) {
+    std::vector<double> distances;
+    std::vector<const Outcome*> outs;
+    for (std::size_t c = 0; c < candidates[v].size(); ++c, ++job) {
+      const Outcome& o = *outcomes[job];
+      distances.push_back(is_failure(o) || is_failure(reference)
+                              ? std::numeric_limits<double>::quiet_NaN()
+                              : problem.distance(reference, o));
+      outs.push_back(&o);
+    }
+    end_distance[v] = distances.back();
+    by_index[v] = !(distances.back() > distances.front());
+    const std::vector<int> chosen = pick_path_points(distances, options.path_fractions);
+    for (std::size_t f = 0; f < chosen.size(); ++f) {
+      const auto c = static_cast<std::size_t>(chosen[f]);
+      picks.push_back({v, candidates[v][c], options.path_fractions[f], distances[c], outs[c], {}, 0, 0});
+    }
+  }
+
+  // Simulate the picked points with recording on; a variation's result is its recorded
+  // motion, exactly as the run left it.
+  std::vector<std::unique_ptr<SimWorker>> workers;
+  for (int w = 0; w < pool.size(); ++w) workers.push_back(evaluator.make_worker());
+  pool.parallel_for(picks.size(), [&](std::size_t i, int worker) {
+    Pick& pick = picks[i];
+    const PathPoint& point = paths[pick.variation][static_cast<std::size_t>(pick.point)];
+    if (point.result) {
+      const RunMotion& m = run.motions[pick.variation];
+      pick.frames = body_frames_json(m.model->get(), m.sample(options.fps));
+      pick.duration = m.duration();
+      return;
+    }
+    ParameterSet set = evaluator.parameters();
+    set.set_normalized(point.x);
+    RunMotion sim;
+    EvaluationOptions eval;
+    eval.recorder = &sim.record;
+    evaluator.evaluate(set.values(), *workers[static_cast<std::size_t>(worker)], eval);
+    pick.frames = body_frames_json(evaluator.model().get(), sim.sample(options.fps));
+    pick.duration = sim.duration();
+  });
+
+  const int task_model = add_model(models, evaluator.model().get());
+  nlohmann::json out = nlohmann::json::array();
+  out.push_back(nullptr);  // M0 has no path
+  for (std::size_t v = 1; v <= variations; ++v) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const Pick& pick : picks) {
+      if (pick.variation != v) continue;
+      const PathPoint& point = paths[v][static_cast<std::size_t>(pick.point)];
+      const RunMotion& m = run.motions[v];
+      const double c = point.result ? m.constraint : pick.outcome->constraint;
+      const bool failed = point.result ? m.failed : pick.outcome->failed;
+      points.push_back(
+          {{"fraction", pick.fraction},
+           {"point", pick.point},
+           {"generation", point.generation},
+           {"step", point.step},
+           {"result", point.result},
+           {"distance", std::isfinite(pick.distance) ? nlohmann::json(pick.distance) : nlohmann::json(nullptr)},
+           {"constraint", std::isfinite(c) ? nlohmann::json(c) : nlohmann::json(nullptr)},
+           {"failed", failed},
+           {"feasible", c == 0.0 && !failed},
+           {"model", point.result ? add_model(models, m.model->get()) : task_model},
+           {"duration", pick.duration},
+           {"frames", pick.frames}});
+    }
+    out.push_back({{"variation", v},
+                   {"label", run.motions[v].label},
+                   {"points_total", paths[v].size()},
+                   {"points_measured", candidates[v].size()},
+                   {"end_distance", std::isfinite(end_distance[v]) ? nlohmann::json(end_distance[v]) : nlohmann::json(nullptr)},
+                   {"by_index", by_index[v]},
+                   {"points", points}});
+  }
+  return out;
+}
+
+}  // namespace
+
+fs::path gallery_template_path() {
+  const char* env = std::getenv("DIVERSE_GALLERY_TEMPLATE");
+  const fs::path path = env && *env ? fs::path(env) : fs::path(DIVERSE_GALLERY_TEMPLATE);
+  if (!path.empty() && fs::exists(path)) return path;
+  const std::string where = path.empty() ? "(no path configured)" : path.string();
+  if (!on_path("node") || !on_path("npm"))
+    throw UserError("gallery: the page template " + where +
+                    " is not built: it needs node and npm; install them (Debian: apt-get install "
+                    "nodejs npm) and run scripts/build.sh");
+  throw UserError("gallery: the page template " + where + " is not built: run `npm ci` in " +
+                  std::string(DIVERSE_SOURCE_DIR) + "/web and rebuild (scripts/build.sh does both)");
+}
+
+std::vector<int> pick_path_points(std::span<const double> distances,
+                                  std::span<const double> fractions) {
+  if (distances.empty()) throw std::invalid_argument("pick_path_points: no points");
+  const int n = static_cast<int>(distances.size());
+  const double start = std::isfinite(distances.front()) ? distances.front() : 0.0;
+  const double end = distances.back();
+  const bool by_index = !(end > start);
+  std::vector<int> picked;
+  for (double f : fractions) {
+    const double index_target = f * (n - 1);
+    if (by_index) {
+      picked.push_back(std::clamp(static_cast<int>(std::lround(index_target)), 0, n - 1));
+      continue;
+    }
+    const double target = start + f * (end - start);
+    int best = -1;
+    double best_gap = 0, best_index_gap = 0;
+    for (int k = 0; k < n; ++k) {
+      const double d = distances[static_cast<std::size_t>(k)];
+      if (!std::isfinite(d)) continue;
+      const double gap = std::abs(d - target);
+      const double index_gap = std::abs(k - index_target);
+      if (best < 0 || gap < best_gap || (gap == best_gap && index_gap < best_index_gap)) {
+        best = k;
+        best_gap = gap;
+        best_index_gap = index_gap;
+      }
+    }
+    picked.push_back(best);
+  }
+  return picked;
+}
+
+nlohmann::json model_json(const mjModel* m) {
+  nlohmann::json bodies = nlohmann::json::array();
+  for (int b = 1; b < m->nbody; ++b) {
+    const char* name = mj_id2name(m, mjOBJ_BODY, b);
+    bodies.push_back({{"name", name ? name : ""}, {"parent", m->body_parentid[b] - 1}});
+  }
+  nlohmann::json geoms = nlohmann::json::array();
+  for (int g = 0; g < m->ngeom; ++g) {
+    // Visible groups only (MuJoCo shows 0-2); the floor plane is drawn by the page itself.
+    if (m->geom_group[g] > 2 || m->geom_type[g] == mjGEOM_PLANE) continue;
+    if (m->geom_rgba[4 * g + 3] == 0.0f && m->geom_matid[g] < 0) continue;
+    geoms.push_back(geom_json(m, g));
+  }
+  double floor = 0;
+  bool has_floor = false;
+  for (int g = 0; g < m->ngeom && !has_floor; ++g) {
+    if (m->geom_bodyid[g] != 0 || m->geom_type[g] != mjGEOM_PLANE) continue;
+    floor = m->geom_pos[3 * g + 2];
+    has_floor = true;
+  }
+  return {{"bodies", bodies},
+          {"geoms", geoms},
+          {"floor", has_floor ? nlohmann::json(round4(floor)) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json body_frames_json(const mjModel* m, std::span<const std::vector<double>> frames) {
+  std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m), mj_deleteData);
+  nlohmann::json data = nlohmann::json::array();
+  for (const std::vector<double>& qpos : frames) {
+    if (static_cast<int>(qpos.size()) != m->nq)
+      throw std::invalid_argument("body_frames_json: qpos of size " + std::to_string(qpos.size()));
+    std::copy(qpos.begin(), qpos.end(), d->qpos);
+    mj_kinematics(m, d.get());
+    for (int b = 1; b < m->nbody; ++b) {
+      for (int i = 0; i < 3; ++i) data.push_back(round4(d->xpos[3 * b + i]));
+      for (int i = 0; i < 4; ++i) data.push_back(round4(d->xquat[4 * b + i]));
+    }
+  }
+  return {{"count", frames.size()}, {"bodies", m->nbody - 1}, {"data", data}};
+}
+
+nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
+  if (!(options.fps > 0)) throw std::invalid_argument("gallery_data: fps must be > 0");
+  const nlohmann::json& s = run.summary;
+  nlohmann::json data = {{"format", "diverse.gallery"},
+                         {"version", 1},
+                         {"task", run.task_name},
+                         {"metric", run.metric},
+                         {"fps", options.fps}};
+  for (const char* key : {"N", "K", "strategy", "seed", "generations", "evaluations", "D",
+                          "all_satisfied", "stop"})
+    if (s.contains(key)) data["run"][key] = s[key];
+
+  nlohmann::json models = nlohmann::json::array();
+  nlohmann::json motions = nlohmann::json::array();
+  for (const RunMotion& m : run.motions) {
+    motions.push_back({{"label", m.label},
+                       {"index", m.index},
+                       {"model", add_model(models, m.model->get())},
+                       {"constraint", m.constraint},
+                       {"dmin", m.dmin},
+                       {"fell", m.fell},
+                       {"failed", m.failed},
+                       {"status", m.status()},
+                       {"duration", m.duration()},
+                       {"frames", body_frames_json(m.model->get(), m.sample(options.fps))}});
+  }
+  nlohmann::json strips = nlohmann::json::array();
+  for (const GroundStrip& g : run.ground_strips) strips.push_back({round4(g.x_min), round4(g.x_max)});
+  data["scene"] = {{"strips", strips}};
+  data["motions"] = motions;
+  data["distances"] = s.contains("distances") ? s["distances"] : nlohmann::json::object();
+  data["notes"] = nlohmann::json::array();
+  if (!run.task_note.empty()) data["notes"].push_back("landing region not drawn: " + run.task_note);
+  if (options.paths && run.motions.size() > 1) {
+    data["paths"] = path_data(run, options, models);
+  } else {
+    data["paths"] = nlohmann::json::array();
+    if (!options.paths) data["notes"].push_back("optimization paths left out (--no-paths)");
+  }
+  data["models"] = models;
+  return data;
+}
+
+std::string gallery_html(const std::string& page_template, const nlohmann::json& data) {
+  const std::size_t at = page_template.find(kPlaceholder);
+  if (at == std::string::npos || page_template.find(kPlaceholder, at + 1) != std::string::npos)
+    throw UserError(std::string("gallery: the page template has no single ") + kPlaceholder +
+                    " placeholder; rebuild it from web/");
+  // JSON inside <script>: "</" would end the element; "<\/" is the same JSON string.
+  std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string escaped;
+  escaped.reserve(json.size());
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    escaped += json[i];
+    if (json[i] == '<' && i + 1 < json.size() && json[i + 1] == '/') escaped += '\\';
+  }
+  std::string html = page_template;
+  html.replace(at, std::string(kPlaceholder).size(), escaped);
+  return html;
+}
+
+fs::path write_gallery(const fs::path& run_dir, const GalleryOptions& options) {
+  const RunView run = load_run_view(run_dir);
+  const fs::path page = options.page_template.empty() ? gallery_template_path() : options.page_template;
+  const std::string page_template = read_file(page);
+  const fs::path out = run.dir / "gallery.html";
+  write_file_atomic(out, gallery_html(page_template, gallery_data(run, options)));
+  return out;
+}
+
+}  // namespace diverse

@@ -1,0 +1,375 @@
+// Pictures, videos and the gallery data of a run, on a small real run directory made with
+// the run's own writers (two simulated jumps, M0 and a variation, and a path between them),
+// and the errors `diverse render`, `gallery` and `export` give on directories that are not
+// finished runs.
+#include "render/run_media.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <set>
+#include <string>
+
+#include "core/error.h"
+#include "io/files.h"
+#include "io/bvh.h"
+#include "io/motion_record.h"
+#include "render/gallery.h"
+#include "render/image.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+
+namespace diverse {
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kTaskFile = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml";
+
+struct Result {
+  int status = -1;
+  std::string output;
+};
+
+Result run_cli(const std::string& args, const std::string& env = "") {
+  const std::string command = (env.empty() ? "" : "env " + env + " ") + std::string(DIVERSE_BINARY) +
+                              " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (pipe && fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
+  const int status = pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string ffprobe_frames(const fs::path& video) {
+  const std::string command = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                              "stream=nb_read_frames -of csv=p=0 " + video.string() + " 2>&1";
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[256];
+  while (pipe && fgets(buffer, sizeof buffer, pipe)) out += buffer;
+  pclose(pipe);
+  while (!out.empty() && (out.back() == '\n' || out.back() == ',')) out.pop_back();
+  return out;
+}
+
+// A run directory as `diverse run` leaves it, written with the same writers: M0 is the
+// task's input motion, M1 the same controller with every parameter moved by 0.06 of its
+// range, and M1's path goes M0 -> half-way -> M1.
+class RunMediaTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // One directory per process: CTest runs the tests of this file as separate processes,
+    // possibly at the same time.
+    dir_ = fs::temp_directory_path() / ("diverse_run_media_test_" + std::to_string(getpid())) / "run";
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "model");
+    fs::create_directories(dir_ / "motions");
+    const TaskEvaluator evaluator(load_task(kTaskFile));
+    const ParameterSet m0 = evaluator.load_parameters(evaluator.task().m0);
+    Eigen::VectorXd x1 = m0.normalized();
+    for (Eigen::Index k = 0; k < x1.size(); ++k)
+      x1[k] = std::clamp(x1[k] + (k % 2 == 0 ? 0.06 : -0.06), 0.0, 1.0);
+    ParameterSet m1 = m0, half = m0;
+    m1.set_normalized(x1);
+    half.set_normalized(0.5 * (m0.normalized() + x1));
+
+    nlohmann::json motions = nlohmann::json::array();
+    int i = 0;
+    for (const ParameterSet* p : std::vector<const ParameterSet*>{&m0, &m1}) {
+      const std::string stem = i == 0 ? "m0" : "m1";
+      const Evaluation e = write_motion(evaluator, *p, {i == 0 ? "M0" : "M1", dir_ / "model" / (stem + ".xml")},
+                                        dir_ / "motions" / (stem + ".json"));
+      motions.push_back({{"index", i}, {"label", i == 0 ? "M0" : "M1"}, {"constraint", e.constraint},
+                         {"dmin", 1.5}, {"fell", e.fell}, {"failed", e.failed},
+                         {"file", "motions/" + stem + ".json"}});
+      ++i;
+    }
+    write_json_atomic(dir_ / "run.json", {{"format", "diverse.run"},
+                                          {"task_file", kTaskFile},
+                                          {"task_text", read_file(kTaskFile)},
+                                          {"metric", "md"}});
+    write_json_atomic(dir_ / "summary.json",
+                      {{"format", "diverse.summary"}, {"task", "jump_high"}, {"metric", "md"},
+                       {"N", 1}, {"generations", 2}, {"motions", motions},
+                       {"distances", {{"objective", "md"}, {"md", {{0.0, 1.5}, {1.5, 0.0}}}}}});
+    nlohmann::json points = nlohmann::json::array();
+    int g = 0;
+    for (const ParameterSet* p : std::vector<const ParameterSet*>{&m0, &half, &m1})
+      points.push_back({{"generation", g}, {"step", g}, {"parameters", p->to_json()}}), ++g;
+    write_json_atomic(dir_ / "paths" / "m1.json", {{"variation", 1}, {"metric", "md"}, {"points", points}});
+  }
+
+  static void TearDownTestSuite() { fs::remove_all(dir_.parent_path()); }
+
+  // A copy of the run to break.
+  static fs::path copy(const std::string& name) {
+    const fs::path to = dir_.parent_path() / name;
+    fs::remove_all(to);
+    fs::copy(dir_, to, fs::copy_options::recursive);
+    return to;
+  }
+
+  static fs::path dir_;
+};
+fs::path RunMediaTest::dir_;
+
+TEST_F(RunMediaTest, ReadsTheRunAndSamplesRecordedStates) {
+  const RunView run = load_run_view(dir_);
+  ASSERT_EQ(run.motions.size(), 2u);
+  EXPECT_EQ(run.task_name, "jump_high");
+  EXPECT_EQ(run.metric, "md");
+  EXPECT_EQ(run.task_note, "");
+  // The task's landing region: x = 0.055 +- 0.15 m.
+  ASSERT_EQ(run.ground_strips.size(), 1u);
+  EXPECT_NEAR(run.ground_strips[0].x_min, -0.095, 1e-12);
+  EXPECT_NEAR(run.ground_strips[0].x_max, 0.205, 1e-12);
+
+  const RunMotion& m = run.motions[1];
+  EXPECT_EQ(m.label, "M1");
+  EXPECT_EQ(m.model_path, dir_ / "model" / "m1.xml");
+  EXPECT_GT(m.duration(), 1.0);
+  EXPECT_GT(m.phases.takeoff(), 0.0);  // phase times read from the motion file
+  const double dt = m.record.timestep;
+  EXPECT_EQ(m.qpos_at(0.0), m.record.qpos0);
+  EXPECT_EQ(m.qpos_at(dt), std::vector<double>(m.record.qpos.begin(), m.record.qpos.begin() + m.record.nq));
+  EXPECT_EQ(m.qpos_at(1e9), std::vector<double>(m.record.qpos.end() - m.record.nq, m.record.qpos.end()));
+  const auto frames = m.sample(30.0);
+  EXPECT_EQ(frames.size(), static_cast<std::size_t>(std::floor(m.duration() * 30.0 + 1e-9)) + 1);
+  EXPECT_EQ(frames[3], m.qpos_at(0.1));
+  const auto slow = m.sample(30.0, 0.5);
+  EXPECT_EQ(slow.size(), static_cast<std::size_t>(std::floor(m.duration() * 60.0 + 1e-9)) + 1);
+  EXPECT_EQ(slow[6], frames[3]);
+  EXPECT_EQ(run.motions[0].status(), run.motions[0].constraint == 0 ? "C = 0, meets the task" : run.motions[0].status());
+}
+
+TEST_F(RunMediaTest, FilmStripHasOneRowPerMotionAndRowsDiffer) {
+  const RunView run = load_run_view(dir_);
+  const fs::path png = dir_.parent_path() / "filmstrip.png";
+  write_run_film_strip(run, png);
+  const Image image = read_png(png.string());
+
+  // The layout of render_film_strip with its defaults: 8 columns (crouch .. end) of
+  // 240 px tiles, 6 px gaps, 12 px margins, a title line and a line of column labels.
+  const int label_w = text_width("M0", FontSize::kLarge) + 8;
+  const int grid_x = 12 + label_w;
+  const int grid_y = 12 + text_height(FontSize::kMedium) + 8 + text_height(FontSize::kLarge) + 4;
+  EXPECT_EQ(image.width(), grid_x + 8 * 240 + 7 * 6 + 12);
+  EXPECT_EQ(image.height(), grid_y + 2 * 240 + 6 + 12);
+
+  // Not blank: a rendered scene has many colours.
+  std::set<int> colours;
+  for (int y = 0; y < image.height(); y += 2)
+    for (int x = 0; x < image.width(); x += 2) {
+      const Rgb p = image.pixel(x, y);
+      colours.insert(p.r << 16 | p.g << 8 | p.b);
+    }
+  EXPECT_GT(colours.size(), 500u);
+
+  // The two rows show different motions: their tiles differ pixel by pixel.
+  long differing = 0;
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 8 * 246 - 6; ++x)
+      if (!(image.pixel(grid_x + x, grid_y + y) == image.pixel(grid_x + x, grid_y + 246 + y))) ++differing;
+  EXPECT_GT(differing, 5000);
+}
+
+TEST_F(RunMediaTest, VideosHaveOneFramePerSample) {
+  const fs::path dir = copy("videos");
+  const RunView run = load_run_view(dir);
+  RunVideoOptions options;
+  options.tile_width = options.tile_height = 96;
+  const auto paths = write_run_videos(run, options);
+  ASSERT_EQ(paths.size(), 3u);
+  EXPECT_EQ(paths[0], dir / "videos" / "m0.mp4");
+  EXPECT_EQ(paths[2], dir / "videos" / "all.mp4");
+  const std::size_t f0 = run.motions[0].sample(30).size(), f1 = run.motions[1].sample(30).size();
+  EXPECT_EQ(ffprobe_frames(paths[0]), std::to_string(f0));
+  EXPECT_EQ(ffprobe_frames(paths[1]), std::to_string(f1));
+  EXPECT_EQ(ffprobe_frames(paths[2]), std::to_string(std::max(f0, f1)));
+
+  options.speed = 0.5;  // half speed: twice the frames
+  const auto slow = write_run_videos(run, options);
+  const std::size_t s0 = run.motions[0].sample(30, 0.5).size(), s1 = run.motions[1].sample(30, 0.5).size();
+  EXPECT_EQ(ffprobe_frames(slow[2]), std::to_string(std::max(s0, s1)));
+}
+
+TEST(PickPathPoints, NearestToEachFractionOfTheEndDistance) {
+  const std::vector<double> fractions{0, 0.25, 0.5, 0.75, 1};
+  EXPECT_EQ(pick_path_points(std::vector<double>{0, 1, 2, 3, 4}, fractions), (std::vector<int>{0, 1, 2, 3, 4}));
+  // Not monotone: 50 % of 8 is nearest to point 1 (d = 4.5); 25 % (2) to point 3 (d = 1.8).
+  EXPECT_EQ(pick_path_points(std::vector<double>{0, 4.5, 9, 1.8, 7, 8}, fractions),
+            (std::vector<int>{0, 3, 1, 4, 5}));
+  // Unknown distances (failed simulations) are skipped.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(pick_path_points(std::vector<double>{0, nan, 5, 10}, std::vector<double>{0.5}), (std::vector<int>{2}));
+  // Ties go to the point nearest in index to the fraction of the path.
+  EXPECT_EQ(pick_path_points(std::vector<double>{0, 2, 2, 2, 4}, std::vector<double>{0.5, 0.25, 0.75}),
+            (std::vector<int>{2, 1, 3}));
+  // An end no farther than the start: by index.
+  EXPECT_EQ(pick_path_points(std::vector<double>{0, 2, 1, 0}, fractions), (std::vector<int>{0, 1, 2, 2, 3}));
+  EXPECT_THROW(pick_path_points(std::vector<double>{}, fractions), std::invalid_argument);
+}
+
+TEST_F(RunMediaTest, GalleryDataHasPosesConstraintsAndThePath) {
+  const RunView run = load_run_view(dir_);
+  GalleryOptions options;
+  options.threads = 2;
+  const nlohmann::json data = gallery_data(run, options);
+  EXPECT_EQ(data["format"], "diverse.gallery");
+  ASSERT_EQ(data["motions"].size(), 2u);
+  const mjModel* m = run.motions[0].model->get();
+  for (std::size_t i = 0; i < 2; ++i) {
+    const nlohmann::json& motion = data["motions"][i];
+    EXPECT_EQ(motion["constraint"], run.motions[i].constraint);
+    const std::size_t count = run.motions[i].sample(30).size();
+    EXPECT_EQ(motion["frames"]["count"], count);
+    EXPECT_EQ(motion["frames"]["bodies"], m->nbody - 1);
+    ASSERT_EQ(motion["frames"]["data"].size(), count * static_cast<std::size_t>(m->nbody - 1) * 7);
+  }
+  // Frame 0 of M0 is the pelvis at its initial position, rounded to 0.1 mm.
+  const nlohmann::json& first = data["motions"][0]["frames"]["data"];
+  EXPECT_NEAR(first[2].get<double>(), run.motions[0].record.qpos0[1] + m->body_pos[3 * 1 + 2], 5e-5);
+  for (const auto& v : first) EXPECT_NEAR(v.get<double>() * 1e4, std::round(v.get<double>() * 1e4), 1e-6);
+  // Models: the planar human's 17 bodies and its geoms but the floor plane, which the page
+  // draws itself.
+  ASSERT_GE(data["models"].size(), 1u);
+  EXPECT_EQ(data["models"][0]["bodies"].size(), 17u);
+  EXPECT_EQ(data["models"][0]["geoms"].size(), static_cast<std::size_t>(m->ngeom - 1));
+  EXPECT_EQ(data["models"][0]["floor"], 0.0);
+  EXPECT_EQ(data["models"][0]["bodies"][0]["name"], "pelvis");
+  EXPECT_NEAR(data["scene"]["strips"][0][0].get<double>(), -0.095, 1e-12);
+  EXPECT_EQ(data["distances"]["md"][0][1], 1.5);
+
+  // M1's path: 0 % is M0 itself, 100 % the result; every point simulated and marked.
+  ASSERT_EQ(data["paths"].size(), 2u);
+  EXPECT_TRUE(data["paths"][0].is_null());
+  const nlohmann::json& path = data["paths"][1];
+  EXPECT_EQ(path["points_total"], 4);  // three means and the result
+  ASSERT_EQ(path["points"].size(), 5u);
+  const nlohmann::json& start = path["points"][0];
+  EXPECT_EQ(start["fraction"], 0.0);
+  EXPECT_EQ(start["point"], 0);
+  EXPECT_EQ(start["distance"], 0.0);
+  const nlohmann::json& end = path["points"][4];
+  EXPECT_EQ(end["point"], 3);
+  EXPECT_TRUE(end["result"].get<bool>());
+  EXPECT_EQ(end["constraint"], run.motions[1].constraint);
+  EXPECT_GT(end["distance"].get<double>(), 0.0);
+  EXPECT_EQ(end["distance"], path["end_distance"]);
+  EXPECT_EQ(end["frames"], data["motions"][1]["frames"]);  // the recorded motion itself
+  for (const auto& p : path["points"]) {
+    EXPECT_EQ(p["feasible"].get<bool>(), p["constraint"] == 0.0 && !p["failed"].get<bool>());
+    EXPECT_GT(p["frames"]["count"].get<int>(), 10);
+  }
+}
+
+TEST(GalleryHtml, DataReplacesThePlaceholderAndCannotEndTheScript) {
+  const std::string page = "<script id=d type=application/json>__DIVERSE_GALLERY_DATA__</script>";
+  const std::string html = gallery_html(page, {{"name", "</script><b>"}});
+  EXPECT_EQ(html, "<script id=d type=application/json>{\"name\":\"<\\/script><b>\"}</script>");
+  try {
+    gallery_html("<html></html>", {});
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "gallery: the page template has no single __DIVERSE_GALLERY_DATA__ "
+                           "placeholder; rebuild it from web/");
+  }
+}
+
+TEST_F(RunMediaTest, CommandsWriteTheirFiles) {
+  const fs::path dir = copy("commands");
+  const fs::path page = dir.parent_path() / "template.html";
+  write_file_atomic(page, "<html><script type=application/json>__DIVERSE_GALLERY_DATA__</script></html>");
+  const Result gallery = run_cli("gallery " + dir.string() + " --no-paths", "DIVERSE_GALLERY_TEMPLATE=" + page.string());
+  ASSERT_EQ(gallery.status, 0) << gallery.output;
+  EXPECT_NE(read_file(dir / "gallery.html").find("\"format\":\"diverse.gallery\""), std::string::npos);
+
+  const Result render = run_cli("render " + dir.string() + " --no-video");
+  ASSERT_EQ(render.status, 0) << render.output;
+  EXPECT_EQ(render.output, (dir / "filmstrip.png").string() + "\n");
+
+  const Result bvh = run_cli("export " + dir.string() + " --bvh --fps 60");
+  ASSERT_EQ(bvh.status, 0) << bvh.output;
+  const RunView run = load_run_view(dir);
+  for (int i = 0; i < 2; ++i) {
+    const Bvh file = read_bvh(dir / "export" / ("m" + std::to_string(i) + ".bvh"));
+    EXPECT_EQ(file.joints.size(), 17u);
+    EXPECT_EQ(file.frame_count(), static_cast<int>(run.motions[static_cast<std::size_t>(i)].sample(60).size()));
+  }
+}
+
+TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
+  const fs::path empty = dir_.parent_path() / "empty";
+  fs::remove_all(empty);
+  fs::create_directories(empty);
+  const fs::path no_motion = copy("no_motion");
+  fs::remove(no_motion / "motions" / "m1.json");
+  const fs::path no_model = copy("no_model");
+  fs::remove(no_model / "model" / "m1.xml");
+  const fs::path unfinished = copy("unfinished");
+  fs::remove(unfinished / "summary.json");
+
+  for (const std::string command : {"render", "gallery", "export --bvh"}) {
+    SCOPED_TRACE(command);
+    Result r = run_cli(command + " " + empty.string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.output, "diverse: error: " + empty.string() +
+                            ": not a run directory (no run.json; `diverse run TASK --out DIR` makes one)\n");
+    r = run_cli(command + " " + no_motion.string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.output, "diverse: error: " + (no_motion / "motions" / "m1.json").string() +
+                            ": missing; the run directory is incomplete (`diverse resume " +
+                            no_motion.string() + "` writes its outputs again)\n");
+    r = run_cli(command + " " + no_model.string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.output, "diverse: error: " + (no_model / "model" / "m1.xml").string() +
+                            ": missing; the run directory is incomplete (`diverse resume " +
+                            no_model.string() + "` writes its outputs again)\n");
+    r = run_cli(command + " " + unfinished.string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.output, "diverse: error: " + (unfinished / "summary.json").string() +
+                            ": missing; the run has not finished (`diverse resume " +
+                            unfinished.string() + "` finishes it)\n");
+    r = run_cli(command + " " + (empty / "nothing").string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.output, "diverse: error: " + (empty / "nothing").string() + ": no such directory\n");
+  }
+
+  Result r = run_cli("render " + dir_.string() + " --fps 45");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "diverse: error: --fps: expected 30 or 60, got 45\n");
+  r = run_cli("export " + dir_.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "diverse: error: export: choose a format: --bvh\n");
+
+  // The page template missing, with no node to build it.
+  r = run_cli("gallery " + dir_.string(), "PATH=/nonexistent DIVERSE_GALLERY_TEMPLATE=/nonexistent/t.html");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "diverse: error: gallery: the page template /nonexistent/t.html is not built: it "
+                      "needs node and npm; install them (Debian: apt-get install nodejs npm) and run "
+                      "scripts/build.sh\n");
+
+  // Paths cannot be simulated once the task file differs from the run's.
+  const fs::path changed = copy("changed");
+  nlohmann::json run = read_json(changed / "run.json");
+  run["task_text"] = "# another task\n";
+  write_json_atomic(changed / "run.json", run);
+  const fs::path page = dir_.parent_path() / "template.html";
+  write_file_atomic(page, "<html>__DIVERSE_GALLERY_DATA__</html>");
+  r = run_cli("gallery " + changed.string(), "DIVERSE_GALLERY_TEMPLATE=" + page.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.output, "diverse: error: " + (changed / "run.json").string() + ": task_file: " + kTaskFile +
+                          " changed since the run; the optimization paths cannot be simulated (restore "
+                          "it, or make the gallery with --no-paths)\n");
+}
+
+}  // namespace
+}  // namespace diverse

@@ -1,0 +1,561 @@
+// The gallery page of `diverse gallery`: every motion of a run side by side in 3D.
+//
+// The data (src/render/gallery.h describes it) is JSON in the page's #gallery-data element:
+// models as bodies and geoms in MuJoCo's conventions (z up, quaternions w first), and per
+// motion the world position and orientation of every body, sampled at data.fps. One WebGL
+// canvas sits behind a grid of tiles; each tile's view is drawn into its own rectangle of
+// the canvas (scissor), through one shared camera, so every motion is seen the same way.
+// Poses between samples are interpolated (positions linearly, orientations by slerp).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+
+const data = JSON.parse(document.getElementById('gallery-data').textContent);
+const $ = (id) => document.getElementById(id);
+
+// ---------------------------------------------------------------- formatting
+
+function fmt(x) {
+  if (x === null || x === undefined || Number.isNaN(x)) return 'n/a';
+  if (x === 0) return '0';
+  const a = Math.abs(x);
+  if (a >= 1e4 || a < 1e-2) return x.toExponential(2).replace('e+', 'e');
+  return x.toPrecision(3);
+}
+const METRIC_NAMES = { hf: 'HF, hands and feet', md: 'MD, mass distance', wja: 'WJA, weighted joint angles' };
+const el = (tag, attrs = {}, text) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+};
+
+// ---------------------------------------------------------------- header
+
+function fillHeader() {
+  const run = data.run || {};
+  const n = data.motions.length - 1;
+  document.title = `${data.task}: ${n} variation${n === 1 ? '' : 's'} (diverse gallery)`;
+  $('title').textContent = data.task;
+  $('subtitle').textContent =
+    `M0 and ${n} variation${n === 1 ? '' : 's'} found by diverse, metric ${(data.metric || '').toUpperCase()}` +
+    (run.strategy ? `, ${run.strategy}` : '');
+  const facts = [
+    ['generations', run.generations], ['evaluations', run.evaluations], ['D', fmt(run.D)],
+    ['constraints', run.all_satisfied === undefined ? undefined : run.all_satisfied ? 'all met' : 'not all met'],
+  ];
+  for (const [k, v] of facts) {
+    if (v === undefined) continue;
+    const d = el('div');
+    d.append(el('dt', {}, k), el('dd', {}, String(v)));
+    $('facts').append(d);
+  }
+  for (const note of data.notes || []) $('notes').append(el('li', {}, note));
+}
+
+// ---------------------------------------------------------------- distance table
+
+function fillDistances() {
+  const dist = data.distances || {};
+  const metrics = ['hf', 'md', 'wja'].filter((m) => Array.isArray(dist[m]));
+  let current = metrics.includes(dist.objective) ? dist.objective : metrics[0];
+  const labels = data.motions.map((m) => m.label);
+  const draw = () => {
+    const table = $('distances');
+    table.replaceChildren();
+    const head = el('tr');
+    head.append(el('th', {}, ''), el('th', {}, 'C'));
+    for (const l of labels) head.append(el('th', {}, l));
+    table.append(head);
+    const d = dist[current] || [];
+    data.motions.forEach((m, i) => {
+      const row = el('tr');
+      row.append(el('th', {}, m.label));
+      const c = el('td', { class: m.constraint === 0 ? 'ok' : 'bad', title: m.status }, fmt(m.constraint));
+      row.append(c);
+      const others = (d[i] || []).filter((_, j) => j !== i);
+      const min = Math.min(...others);
+      (d[i] || []).forEach((v, j) => {
+        const cell = el('td', {}, i === j ? '-' : fmt(v));
+        if (i === j) cell.className = 'self';
+        else if (v === min) cell.className = 'min';
+        row.append(cell);
+      });
+      table.append(row);
+    });
+    $('distance-hint').textContent =
+      `d(Mi, Mj) under ${METRIC_NAMES[current] || current}` +
+      (current === dist.objective ? ' (the metric the run optimized)' : '') +
+      '. In bold, each motion\'s nearest neighbour (dmin). C is the constraint penalty: 0 when the task is met.';
+    for (const b of $('metric-tabs').children) b.setAttribute('aria-selected', String(b.dataset.metric === current));
+  };
+  for (const m of metrics) {
+    const b = el('button', { type: 'button', role: 'tab', 'data-metric': m }, m.toUpperCase());
+    b.addEventListener('click', () => { current = m; draw(); });
+    $('metric-tabs').append(b);
+  }
+  if (metrics.length) draw();
+  else $('distance-panel').hidden = true;
+}
+
+// ---------------------------------------------------------------- tracks (what a tile shows)
+
+// A track: one motion's frames on one model.
+function makeTrack(source, label) {
+  const f = source.frames;
+  return {
+    label,
+    model: source.model,
+    count: f.count,
+    bodies: f.bodies,
+    data: Float32Array.from(f.data),
+    duration: source.duration,
+  };
+}
+
+const tiles = data.motions.map((m, i) => {
+  const path = (data.paths || [])[i] || null;
+  return {
+    index: i,
+    motion: m,
+    main: makeTrack(m, m.label),
+    path,
+    pathTracks: path ? path.points.map((p) => makeTrack(p, `${m.label} at ${Math.round(p.fraction * 100)} %`)) : [],
+    pathIndex: path ? path.points.length - 1 : -1,
+  };
+});
+const shownTrack = (tile) => (tile.pathIndex >= 0 && tile.path ? tile.pathTracks[tile.pathIndex] : tile.main);
+const duration = () => Math.max(1e-6, ...tiles.map((t) => shownTrack(t).duration));
+
+// ---------------------------------------------------------------- three.js scene
+
+const canvas = $('view');
+let renderer;
+try {
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: true, preserveDrawingBuffer: true });
+} catch (e) {
+  $('webgl-error').hidden = false;
+  $('stage').hidden = true;
+  throw e;
+}
+renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+renderer.shadowMap.enabled = true;
+renderer.shadowMap.type = THREE.PCFShadowMap;
+renderer.setClearColor(0x000000, 0);
+
+const scene = new THREE.Scene();
+// Sky: a vertical gradient, pale at the top, bluish at the horizon (as in the film strips).
+{
+  const sky = document.createElement('canvas');
+  sky.width = 2; sky.height = 256;
+  const g = sky.getContext('2d');
+  const grad = g.createLinearGradient(0, 0, 0, 256);
+  grad.addColorStop(0, '#fafbfd');
+  grad.addColorStop(1, '#d6e0ec');
+  g.fillStyle = grad;
+  g.fillRect(0, 0, 2, 256);
+  const texture = new THREE.CanvasTexture(sky);
+  texture.colorSpace = THREE.SRGBColorSpace;
+  scene.background = texture;
+}
+
+scene.add(new THREE.HemisphereLight(0xffffff, 0x9a968c, 2.4));
+const sun = new THREE.DirectionalLight(0xffffff, 2.5);
+sun.castShadow = true;
+sun.shadow.mapSize.set(2048, 2048);
+sun.shadow.bias = -0.0004;
+sun.shadow.normalBias = 0.01;
+scene.add(sun, sun.target);
+
+// The extent of everything that moves (to place the floor and the light), and of the
+// motions the run found and the landing region (to place the camera: path points that
+// fall far away may leave the view, as a zoom out shows).
+function extent(tracks) {
+  const box = new THREE.Box3();
+  const p = new THREE.Vector3();
+  for (const track of tracks) {
+    const d = track.data;
+    for (let k = 0; k < d.length; k += 7) box.expandByPoint(p.set(d[k], d[k + 1], d[k + 2]));
+  }
+  if (box.isEmpty()) box.set(new THREE.Vector3(-1, -0.3, 0), new THREE.Vector3(1, 0.3, 1.6));
+  box.expandByScalar(0.15);  // body radius and a little air
+  return box;
+}
+const floorZ = data.models.find((m) => m.floor !== null)?.floor ?? 0;
+const bounds = extent(tiles.flatMap((t) => [t.main, ...t.pathTracks]));
+const viewBounds = extent(tiles.map((t) => t.main));
+for (const box of [bounds, viewBounds]) {
+  box.min.z = Math.min(box.min.z, floorZ);
+  for (const [x0, x1] of data.scene?.strips || []) {
+    box.expandByPoint(new THREE.Vector3(x0, 0, floorZ));
+    box.expandByPoint(new THREE.Vector3(x1, 0, floorZ));
+  }
+}
+const center = bounds.getCenter(new THREE.Vector3());
+
+// Floor: a plain ground, a track along x banded every 0.5 m, the landing region in green.
+// The three layers lie a centimetre apart and are pushed apart in depth as well
+// (polygonOffset), so they never fight for the same pixels when seen from afar.
+{
+  const layer = (color, offset) => new THREE.MeshStandardMaterial({
+    color, roughness: 1, polygonOffset: true, polygonOffsetFactor: offset, polygonOffsetUnits: offset });
+  const ground = new THREE.Mesh(new THREE.PlaneGeometry(120, 120), layer(0xe9e9e6, 4));
+  ground.position.set(center.x, 0, floorZ - 0.01);
+  ground.receiveShadow = true;
+  scene.add(ground);
+  const band = 0.5;
+  const light = layer(0xdcdcda, 2);
+  const dark = layer(0xc4c4c1, 2);
+  const geometry = new THREE.PlaneGeometry(band, 2);
+  for (let k = Math.floor((bounds.min.x - 6) / band); k < Math.ceil((bounds.max.x + 6) / band); ++k) {
+    const tile = new THREE.Mesh(geometry, ((k % 2) + 2) % 2 === 0 ? light : dark);
+    tile.position.set((k + 0.5) * band, 0, floorZ - 0.005);
+    tile.receiveShadow = true;
+    scene.add(tile);
+  }
+  const green = layer(0x5fb35f, 0);
+  for (const [x0, x1] of data.scene?.strips || []) {
+    const strip = new THREE.Mesh(new THREE.PlaneGeometry(x1 - x0, 2.2), green);
+    strip.position.set(0.5 * (x0 + x1), 0, floorZ);
+    strip.receiveShadow = true;
+    scene.add(strip);
+  }
+  // Metre marks along the far edge of the track, facing the camera.
+  for (let x = Math.ceil(bounds.min.x - 1); x <= Math.floor(bounds.max.x + 1); ++x) {
+    const label = document.createElement('canvas');
+    label.width = 128; label.height = 64;
+    const g = label.getContext('2d');
+    g.fillStyle = '#5b636d';
+    g.font = '600 38px system-ui, sans-serif';
+    g.textAlign = 'center';
+    g.textBaseline = 'middle';
+    g.fillText(`${x} m`, 64, 32);
+    const texture = new THREE.CanvasTexture(label);
+    texture.colorSpace = THREE.SRGBColorSpace;
+    const mark = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthWrite: false }));
+    mark.scale.set(0.32, 0.16, 1);
+    mark.position.set(x, 1.25, floorZ + 0.08);
+    scene.add(mark);
+  }
+}
+
+// ---------------------------------------------------------------- models
+
+function geomMesh(g, material) {
+  const [a, b, c] = g.size;
+  let geometry;
+  switch (g.type) {
+    // MuJoCo's capsules and cylinders lie along their local z; three.js's along y.
+    case 'capsule': geometry = new THREE.CapsuleGeometry(a, 2 * b, 6, 16).rotateX(Math.PI / 2); break;
+    case 'cylinder': geometry = new THREE.CylinderGeometry(a, a, 2 * b, 20).rotateX(Math.PI / 2); break;
+    case 'sphere': geometry = new THREE.SphereGeometry(a, 20, 14); break;
+    case 'ellipsoid': geometry = new THREE.SphereGeometry(1, 20, 14).scale(a, b, c); break;
+    case 'box': geometry = new THREE.BoxGeometry(2 * a, 2 * b, 2 * c); break;
+    default: return null;  // meshes and height fields are not exported
+  }
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.position.fromArray(g.pos);
+  mesh.quaternion.set(g.quat[1], g.quat[2], g.quat[3], g.quat[0]);
+  mesh.castShadow = true;
+  mesh.receiveShadow = true;
+  return mesh;
+}
+
+function materialFor(rgba, ghost) {
+  if (ghost) {
+    return new THREE.MeshStandardMaterial({
+      color: 0x7f97ba, transparent: true, opacity: 0.28, depthWrite: false, roughness: 0.8 });
+  }
+  const color = new THREE.Color().setRGB(rgba[0], rgba[1], rgba[2], THREE.SRGBColorSpace);
+  return new THREE.MeshStandardMaterial({
+    color, roughness: 0.55, metalness: 0.0, transparent: rgba[3] < 1, opacity: rgba[3] });
+}
+
+// A rig: one group per body of a model. Rigs are shared by the tiles (each tile poses the
+// rig just before its view is drawn), so a model is built once (once more as a ghost).
+const rigs = new Map();
+let sceneObjectsAdded = false;
+function rig(modelIndex, ghost = false) {
+  const key = `${modelIndex}:${ghost}`;
+  if (rigs.has(key)) return rigs.get(key);
+  const model = data.models[modelIndex];
+  const root = new THREE.Group();
+  const bodies = model.bodies.map(() => new THREE.Group());
+  for (const b of bodies) root.add(b);
+  const materials = new Map();
+  for (const g of model.geoms) {
+    const k = g.rgba.join(',');
+    if (!materials.has(k)) materials.set(k, materialFor(g.rgba, ghost));
+    const mesh = geomMesh(g, materials.get(k));
+    if (!mesh) continue;
+    if (ghost) mesh.castShadow = false;
+    if (g.body < 0) {
+      if (!ghost && !sceneObjectsAdded) scene.add(mesh);  // a scene object, drawn once
+    } else {
+      bodies[g.body].add(mesh);
+    }
+  }
+  if (!ghost) sceneObjectsAdded = true;
+  root.visible = false;
+  scene.add(root);
+  const r = { root, bodies };
+  rigs.set(key, r);
+  return r;
+}
+
+const qa = new THREE.Quaternion();
+const qb = new THREE.Quaternion();
+function pose(r, track, t) {
+  const f = Math.min(Math.max(t, 0) * data.fps, track.count - 1);
+  const i0 = Math.floor(f);
+  const i1 = Math.min(i0 + 1, track.count - 1);
+  const a = f - i0;
+  const d = track.data;
+  const stride = track.bodies * 7;
+  for (let b = 0; b < track.bodies; ++b) {
+    const k0 = i0 * stride + b * 7;
+    const k1 = i1 * stride + b * 7;
+    const body = r.bodies[b];
+    body.position.set(
+      d[k0] + a * (d[k1] - d[k0]), d[k0 + 1] + a * (d[k1 + 1] - d[k0 + 1]), d[k0 + 2] + a * (d[k1 + 2] - d[k0 + 2]));
+    qa.set(d[k0 + 4], d[k0 + 5], d[k0 + 6], d[k0 + 3]);
+    qb.set(d[k1 + 4], d[k1 + 5], d[k1 + 6], d[k1 + 3]);
+    body.quaternion.slerpQuaternions(qa, qb, a);
+  }
+}
+
+for (const t of tiles) {
+  rig(t.main.model);
+  for (const p of t.pathTracks) rig(p.model);
+  if (t.path) rig(t.main.model, true);
+}
+
+// ---------------------------------------------------------------- camera
+
+const camera = new THREE.PerspectiveCamera(30, 1, 0.1, 150);
+camera.up.set(0, 0, 1);
+const target = center.clone();
+
+// Seen from the character's right (-y), a little ahead and above: a side view that keeps
+// a sense of depth. The distance fits the whole box in view (as fit_side_camera does).
+function sideView(aspect) {
+  const az = THREE.MathUtils.degToRad(18);
+  const el = THREE.MathUtils.degToRad(10);
+  const back = new THREE.Vector3(Math.sin(az) * Math.cos(el), -Math.cos(az) * Math.cos(el), Math.sin(el));
+  const forward = back.clone().negate();
+  const right = new THREE.Vector3().crossVectors(forward, camera.up).normalize();
+  const up = new THREE.Vector3().crossVectors(right, forward).normalize();
+  const tanV = Math.tan(THREE.MathUtils.degToRad(camera.fov / 2)) * 0.96;
+  const tanH = tanV * aspect;
+  const middle = viewBounds.getCenter(new THREE.Vector3());
+  target.copy(middle);
+  let dist = 0.5;
+  for (let c = 0; c < 8; ++c) {
+    const q = new THREE.Vector3(
+      c & 1 ? viewBounds.max.x : viewBounds.min.x, c & 2 ? viewBounds.max.y : viewBounds.min.y,
+      c & 4 ? viewBounds.max.z : viewBounds.min.z,
+    ).sub(middle);
+    dist = Math.max(dist, Math.abs(q.dot(right)) / tanH - q.dot(forward), Math.abs(q.dot(up)) / tanV - q.dot(forward));
+  }
+  camera.position.copy(middle).addScaledVector(back, dist);
+  camera.lookAt(target);
+  for (const c of controls) c.update();
+}
+
+// The light follows the motions' area so its shadow map stays sharp.
+{
+  const size = bounds.getSize(new THREE.Vector3());
+  const r = 0.6 * Math.max(size.x, size.z, 2);
+  sun.position.set(center.x + 1.5, center.y - 2.5, center.z + 6);
+  sun.target.position.copy(center);
+  Object.assign(sun.shadow.camera, { left: -r, right: r, top: r, bottom: -r, near: 0.5, far: 20 });
+  sun.shadow.camera.updateProjectionMatrix();
+}
+
+// ---------------------------------------------------------------- tiles (DOM)
+
+const columns = Math.min(tiles.length, tiles.length <= 4 ? tiles.length : tiles.length <= 6 ? 3 : 4);
+$('tiles').style.setProperty('--columns', String(columns));
+const controls = [];
+let needsRender = true;
+const requestRender = () => { needsRender = true; };
+
+function statusOf(c, failed, fell) {
+  if (c === 0 && !failed) return { text: 'C = 0 · meets the task', ok: true };
+  return { text: `C = ${fmt(c)} · ${failed ? 'failed' : fell ? 'fell' : 'misses the task'}`, ok: false };
+}
+
+function updateTileText(t) {
+  const point = t.path && t.pathIndex >= 0 ? t.path.points[t.pathIndex] : null;
+  const s = point && !point.result
+    ? statusOf(point.constraint, point.failed, false)
+    : statusOf(t.motion.constraint, t.motion.failed, t.motion.fell);
+  t.status.textContent = s.text;
+  t.status.className = `status ${s.ok ? 'ok' : 'bad'}`;
+  t.dom.classList.toggle('infeasible', !s.ok);
+  if (!point) return;
+  const pct = Math.round(point.fraction * 100);
+  const where = point.result ? 'the result' : point.generation === 0 ? 'the start (M0)' : `after generation ${point.generation}`;
+  t.caption.replaceChildren();
+  t.caption.append(`${pct} %: ${where}, d(M0) = ${fmt(point.distance)}, `);
+  t.caption.append(el('span', { class: point.feasible ? 'ok' : 'bad' },
+    point.feasible ? 'meets the task' : `misses the task (C = ${fmt(point.constraint)})`));
+}
+
+for (const t of tiles) {
+  const dom = el('div', { class: 'tile', 'data-motion': t.motion.label });
+  const head = el('div', { class: 'tile-head' });
+  t.status = el('span', { class: 'status' });
+  head.append(el('span', { class: 'label' }, t.motion.label), t.status);
+  const viewport = el('div', { class: 'viewport', 'aria-label': `${t.motion.label} in 3D` });
+  const foot = el('div', { class: 'tile-foot' });
+  if (t.path && t.path.points.length) {
+    const title = el('div', { class: 'path-title' });
+    title.append(el('span', {}, 'Optimization path'),
+      el('span', {}, `${t.path.points_total} points${t.path.by_index ? ', by step' : ''}`));
+    const slider = el('input', {
+      type: 'range', class: 'path', min: '0', max: String(t.path.points.length - 1), step: '1',
+      value: String(t.path.points.length - 1), 'aria-label': `${t.motion.label} optimization path`,
+    });
+    const ticks = el('div', { class: 'ticks' });
+    for (const p of t.path.points) {
+      ticks.append(el('span', {
+        class: p.feasible ? '' : 'bad',
+        title: p.feasible ? 'meets the task' : `misses the task (C = ${fmt(p.constraint)})`,
+      }, `${Math.round(p.fraction * 100)}%${p.feasible ? '' : ' ✗'}`));
+    }
+    t.caption = el('div', { class: 'path-caption' });
+    slider.addEventListener('input', () => {
+      t.pathIndex = Number(slider.value);
+      updateTileText(t);
+      syncScrubber();
+      requestRender();
+    });
+    foot.append(title, slider, ticks, t.caption);
+  } else {
+    foot.append(el('div', { class: 'm0-note' },
+      t.index === 0 ? 'M0, the input motion: every variation starts here and is pushed away from it.'
+                    : 'No optimization path in this gallery.'));
+  }
+  dom.append(head, viewport, foot);
+  $('tiles').append(dom);
+  Object.assign(t, { dom, viewport });
+  updateTileText(t);
+
+  const c = new OrbitControls(camera, viewport);
+  c.target = target;  // one target object shared by every view's controls
+  c.enableDamping = false;
+  c.addEventListener('change', requestRender);
+  controls.push(c);
+}
+
+// ---------------------------------------------------------------- playback
+
+let time = 0;
+// Plays on opening, unless the address ends in #paused.
+let playing = !/paused/.test(location.hash);
+let last = performance.now();
+let holdUntil = 0;
+const speed = () => ($('half').checked ? 0.5 : 1);
+
+function syncScrubber() {
+  const T = duration();
+  time = Math.min(time, T);
+  $('time').value = String(Math.round((time / T) * 1000));
+  $('clock').textContent = `${time.toFixed(2)} s / ${T.toFixed(2)} s`;
+}
+
+$('play').addEventListener('click', () => {
+  playing = !playing;
+  $('play').textContent = playing ? 'Pause' : 'Play';
+  last = performance.now();
+});
+$('time').addEventListener('input', () => {
+  time = (Number($('time').value) / 1000) * duration();
+  $('clock').textContent = `${time.toFixed(2)} s / ${duration().toFixed(2)} s`;
+  requestRender();
+});
+$('half').addEventListener('change', () => { last = performance.now(); });
+$('reset-view').addEventListener('click', () => { sideView(aspect()); requestRender(); });
+document.addEventListener('keydown', (e) => {
+  if (e.code === 'Space' && e.target === document.body) { e.preventDefault(); $('play').click(); }
+});
+
+// ---------------------------------------------------------------- drawing
+
+function aspect() {
+  const r = tiles[0].viewport.getBoundingClientRect();
+  return r.height > 0 ? r.width / r.height : 1;
+}
+
+function resize() {
+  const stage = $('stage');
+  const w = stage.clientWidth;
+  const h = stage.clientHeight;
+  if (canvas.width !== Math.round(w * renderer.getPixelRatio()) ||
+      canvas.height !== Math.round(h * renderer.getPixelRatio())) {
+    renderer.setSize(w, h, false);
+    needsRender = true;
+  }
+}
+
+function draw() {
+  resize();
+  const stageRect = canvas.getBoundingClientRect();
+  renderer.setScissorTest(false);
+  renderer.clear();
+  renderer.setScissorTest(true);
+  for (const t of tiles) {
+    const r = t.viewport.getBoundingClientRect();
+    if (r.bottom < 0 || r.top > window.innerHeight || r.width === 0) continue;
+    const x = r.left - stageRect.left;
+    const y = stageRect.bottom - r.bottom;
+    renderer.setViewport(x, y, r.width, r.height);
+    renderer.setScissor(x, y, r.width, r.height);
+    camera.aspect = r.width / r.height;
+    camera.updateProjectionMatrix();
+
+    for (const r of rigs.values()) r.root.visible = false;
+    const track = shownTrack(t);
+    const main = rig(track.model);
+    pose(main, track, time);
+    main.root.visible = true;
+    const point = t.path && t.pathIndex >= 0 ? t.path.points[t.pathIndex] : null;
+    if (point && !point.result) {  // the result as a faint figure, for comparison
+      const ghost = rig(t.main.model, true);
+      pose(ghost, t.main, time);
+      ghost.root.visible = true;
+    }
+    renderer.render(scene, camera);
+  }
+}
+
+function frame(now) {
+  const dt = Math.min((now - last) / 1000, 0.1);
+  last = now;
+  if (playing) {
+    const T = duration();
+    if (time >= T) {
+      if (!holdUntil) holdUntil = now + 600;  // hold the end a moment before looping
+      if (now >= holdUntil) { time = 0; holdUntil = 0; }
+    } else {
+      time = Math.min(T, time + dt * speed());
+    }
+    syncScrubber();
+    needsRender = true;
+  }
+  if (needsRender) {
+    needsRender = false;
+    draw();
+    if (!document.body.dataset.ready) document.body.dataset.ready = '1';
+  }
+  requestAnimationFrame(frame);
+}
+
+fillHeader();
+fillDistances();
+$('play').textContent = playing ? 'Pause' : 'Play';
+new ResizeObserver(requestRender).observe($('stage'));
+window.addEventListener('scroll', requestRender, { passive: true });
+sideView(aspect());
+syncScrubber();
+requestAnimationFrame(frame);

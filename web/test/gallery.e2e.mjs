@@ -1,0 +1,204 @@
+// End-to-end test of a run's gallery page and BVH export, in headless Chromium with no
+// network (tests/e2e/gallery_e2e.sh makes the run, its gallery.html and export/*.bvh).
+//
+//   node test/gallery.e2e.mjs RUN_DIR
+//
+// Checks: the page loads from a file:// URL and requests nothing else; it logs no errors;
+// the canvas draws (its pixels are not uniform); moving the time scrubber and a path slider
+// change the picture; infeasible path points are marked; the first BVH file loads with
+// three.js's BVHLoader with one joint per moving body and one frame per 1/30 s of motion,
+// and its forward kinematics (as three.js plays it) puts every joint within 1 mm of the
+// body's position in the page's data (MuJoCo's xpos). Writes RUN_DIR/gallery-screenshot.png.
+// Chromium: $CHROMIUM or /usr/bin/chromium.
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+import { chromium } from 'playwright-core';
+import * as THREE from 'three';
+import { BVHLoader } from 'three/examples/jsm/loaders/BVHLoader.js';
+
+const runDir = resolve(process.argv[2] ?? '');
+if (!process.argv[2]) {
+  console.error('usage: node test/gallery.e2e.mjs RUN_DIR');
+  process.exit(2);
+}
+const executablePath = process.env.CHROMIUM || '/usr/bin/chromium';
+
+let passed = 0;
+let failed = 0;
+function check(ok, what, detail = '') {
+  if (ok) {
+    passed++;
+    console.log(`ok - ${what}`);
+  } else {
+    failed++;
+    console.log(`FAIL - ${what}${detail ? `: ${detail}` : ''}`);
+  }
+}
+
+// ---------------------------------------------------------------- the page
+
+const userDataDir = mkdtempSync(join(tmpdir(), 'diverse-e2e-chromium-'));
+const context = await chromium.launchPersistentContext(userDataDir, {
+  executablePath,
+  headless: true,
+  viewport: { width: 1400, height: 1100 },
+  args: [
+    '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync',
+    // WebGL on the CPU: Chromium's SwiftShader must be allowed explicitly without a GPU.
+    '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+  ],
+});
+const errors = [];
+const outside = [];
+try {
+  await context.route('**/*', (route) => {
+    const url = route.request().url();
+    if (url.startsWith('file://')) return route.continue();
+    outside.push(url);
+    return route.abort();
+  });
+  const page = await context.newPage();
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+  page.on('requestfailed', (r) => {
+    if (!r.url().startsWith('file://')) return;
+    errors.push(`request failed: ${r.url()} (${r.failure()?.errorText})`);
+  });
+
+  // Opened paused (#paused): software WebGL is slow, and a still page answers at once.
+  const url = `${pathToFileURL(join(runDir, 'gallery.html')).href}#paused`;
+  await page.goto(url);
+  await page.waitForSelector('body[data-ready="1"]', { timeout: 30000 });
+  check(true, 'gallery.html loads and draws its first frame');
+  check((await page.textContent('#play')).trim() === 'Play', 'the page opens paused when asked (#paused)');
+  // Two clicks in one task, so no slow frame is drawn in between.
+  const labels = await page.evaluate(() => {
+    const b = document.getElementById('play');
+    b.click();
+    const first = b.textContent;
+    b.click();
+    return [first, b.textContent];
+  });
+  check(labels[0] === 'Pause' && labels[1] === 'Play', 'the play/pause button plays and pauses', labels.join(', '));
+
+  const data = await page.evaluate(() => JSON.parse(document.getElementById('gallery-data').textContent));
+  check(await page.locator('.tile').count() === data.motions.length, 'one tile per motion',
+    `${await page.locator('.tile').count()} tiles, ${data.motions.length} motions`);
+
+  // Two animation frames, so what was asked for is on the canvas.
+  const settle = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  // Pixel statistics of the WebGL canvas; `keep` stores the pixels to compare the next call with.
+  const snapshot = () => page.evaluate(() => {
+    const c = document.getElementById('view');
+    const copy = document.createElement('canvas');
+    copy.width = c.width;
+    copy.height = c.height;
+    const g = copy.getContext('2d');
+    g.drawImage(c, 0, 0);
+    const px = g.getImageData(0, 0, c.width, c.height).data;
+    const colours = new Set();
+    let changed = 0;
+    const before = window.__lastPixels;
+    for (let i = 0; i < px.length; i += 4) {
+      if (colours.size < 5000) colours.add((px[i] << 16) | (px[i + 1] << 8) | px[i + 2]);
+      if (before && (before[i] !== px[i] || before[i + 1] !== px[i + 1] || before[i + 2] !== px[i + 2])) changed++;
+    }
+    window.__lastPixels = px;
+    return { colours: colours.size, changed, width: c.width, height: c.height };
+  });
+
+  await page.locator('#time').fill('0');
+  await settle();
+  const start = await snapshot();
+  check(start.width > 0 && start.colours > 100, 'the canvas draws (pixels not uniform)',
+    `${start.colours} distinct colours in ${start.width}x${start.height}`);
+
+  await page.locator('#time').fill('450');
+  await settle();
+  const middle = await snapshot();
+  check(middle.changed > 2000, 'moving the time scrubber changes the picture', `${middle.changed} pixels changed`);
+  const clock = await page.textContent('#clock');
+  check(/^0\.\d\d s \/ \d+\.\d\d s$/.test(clock) && !clock.startsWith('0.00'), 'the clock shows the scrubbed time', clock);
+
+  // A path slider: from the result (100 %) to a point whose motion differs from it.
+  const v = data.paths.findIndex((p) => p && p.points.length > 1);
+  check(v > 0, 'the page has an optimization path with several points');
+  if (v > 0) {
+    const points = data.paths[v].points;
+    const last = points[points.length - 1];
+    const other = points.findIndex((p) => p.frames.data.some((x, i) => x !== last.frames.data[i]) ||
+                                          p.frames.count !== last.frames.count);
+    check(other >= 0, `M${v}'s path points differ in motion`);
+    const slider = page.locator('input.path').nth(v - 1);
+    const tile = page.locator(`.tile[data-motion="M${v}"]`);
+    const captionBefore = await tile.locator('.path-caption').textContent();
+    await slider.fill(String(Math.max(other, 0)));
+    await settle();
+    const moved = await snapshot();
+    check(moved.changed > 500, 'moving a path slider changes the picture', `${moved.changed} pixels changed`);
+    const captionAfter = await tile.locator('.path-caption').textContent();
+    check(captionAfter !== captionBefore, 'the path caption follows the slider', `${captionBefore} -> ${captionAfter}`);
+    // Every point is marked as meeting the task or not, as its constraint says.
+    let marks = 0;
+    for (let k = 0; k < points.length; ++k) {
+      await slider.fill(String(k));
+      const infeasible = await tile.evaluate((e) => e.classList.contains('infeasible'));
+      const caption = await tile.locator('.path-caption').textContent();
+      const expected = !points[k].feasible;
+      if (infeasible === expected && caption.includes(expected ? 'misses the task' : 'meets the task')) marks++;
+    }
+    check(marks === points.length, 'infeasible path points are marked (C > 0)', `${marks} of ${points.length}`);
+    await slider.fill(String(points.length - 1));
+  }
+
+  await page.locator('#time').fill('500');
+  await settle();
+  await page.screenshot({ path: join(runDir, 'gallery-screenshot.png'), fullPage: true });
+
+  check(errors.length === 0, 'the page logs no errors', errors.join(' | '));
+  check(outside.length === 0, 'the page requests nothing but its own file', outside.join(' '));
+
+  // ---------------------------------------------------------------- BVH in three.js
+
+  const motion = data.motions[0];
+  const model = data.models[motion.model];
+  const text = readFileSync(join(runDir, 'export', 'm0.bvh'), 'utf8');
+  const { skeleton, clip } = new BVHLoader().parse(text);
+  const joints = skeleton.bones.filter((b) => b.name !== 'ENDSITE');
+  check(joints.length === model.bodies.length, 'BVHLoader: one joint per moving body',
+    `${joints.length} joints, ${model.bodies.length} bodies`);
+  const frames = clip.tracks[0].times.length;
+  check(frames === motion.frames.count, 'BVHLoader: one frame per 1/30 s of the motion',
+    `${frames} frames, ${motion.frames.count} expected`);
+
+  // Play the clip in three.js and compare joint positions with MuJoCo's body positions
+  // (BVH axes: (x, z, -y) of MuJoCo's).
+  const root = skeleton.bones[0];
+  const mixer = new THREE.AnimationMixer(root);
+  // Played once and held, so the last frame's time does not wrap back to the first.
+  mixer.clipAction(clip).setLoop(THREE.LoopOnce, 1).play().clampWhenFinished = true;
+  const byName = new Map(joints.map((b) => [b.name, b]));
+  let worst = 0;
+  for (const k of [0, Math.floor(frames / 3), Math.floor((2 * frames) / 3), frames - 1]) {
+    mixer.setTime(clip.tracks[0].times[k]);
+    root.updateMatrixWorld(true);
+    model.bodies.forEach((body, b) => {
+      const bone = byName.get(body.name);
+      if (!bone) { worst = Infinity; return; }
+      const p = new THREE.Vector3().setFromMatrixPosition(bone.matrixWorld);
+      const o = (k * motion.frames.bodies + b) * 7;
+      const d = motion.frames.data;
+      worst = Math.max(worst, p.distanceTo(new THREE.Vector3(d[o], d[o + 2], -d[o + 1])));
+    });
+  }
+  check(worst < 1e-3, 'BVHLoader: joints within 1 mm of MuJoCo\'s body positions', `worst ${(worst * 1000).toFixed(3)} mm`);
+} finally {
+  await context.close();
+  rmSync(userDataDir, { recursive: true, force: true });
+}
+
+console.log(`gallery e2e: ${passed} passed, ${failed} failed`);
+process.exit(failed === 0 ? 0 : 1);
