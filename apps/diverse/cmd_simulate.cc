@@ -13,7 +13,7 @@
 #include "core/error.h"
 #include "io/motion_record.h"
 #include "render/film_strip.h"
-#include "run/outputs.h"
+#include "render/film_columns.h"
 #include "task/evaluate.h"
 
 namespace diverse::cli {

@@ -53,7 +53,10 @@ Eigen::VectorXd ParameterSet::normalized() const {
 void ParameterSet::set_normalized(const Eigen::VectorXd& x) {
   if (x.size() != size()) throw std::logic_error("ParameterSet: normalized vector size mismatch");
   for (int i = 0; i < size(); ++i) {
-    values_[i] = specs_[i].lower + x[i] * (specs_[i].upper - specs_[i].lower);
+    // x = 1 maps to the upper bound exactly: lower + 1 * (upper - lower) can round past
+    // it, and a value past its bound is refused when the parameters are read back.
+    values_[i] = x[i] == 1.0 ? specs_[i].upper
+                             : specs_[i].lower + x[i] * (specs_[i].upper - specs_[i].lower);
   }
 }
 

@@ -10,7 +10,7 @@
 #include "io/motion_record.h"
 #include "render/film_strip.h"
 #include "render/video.h"
-#include "run/outputs.h"
+#include "render/film_columns.h"
 #include "task/task.h"
 
 namespace diverse {

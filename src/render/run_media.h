@@ -9,7 +9,7 @@
 //
 //   filmstrip.png     the paper's figure 5: one row per motion (M0 on top), one column
 //                     per phase event of the jump (A crouch, B extend, C take-off, ...;
-//                     run/outputs.h, jump_film_columns), one shared side camera, scene
+//                     render/film_columns.h, jump_film_columns), one shared side camera, scene
 //                     objects drawn and the landing region marked on the floor
 //   videos/m<i>.mp4   each motion alone, labelled with its constraint value
 //   videos/all.mp4    all motions side by side in step, through one shared camera;

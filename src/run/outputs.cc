@@ -8,7 +8,7 @@
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/model.h"
-#include "render/film_strip.h"
+#include "render/run_media.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
@@ -41,37 +41,6 @@ std::string label(std::size_t i) { return numbered('M', i); }
 std::string stem(std::size_t i) { return numbered('m', i); }
 
 }  // namespace
-
-FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
-  FilmColumns columns;
-  const double dt = record.timestep;
-  auto frame_at = [&](double t) {
-    // qpos row k is the state after step k, at time (k + 1) dt; t = 0 is qpos0.
-    const int steps = record.steps();
-    const long k = std::lround(t / dt) - 1;
-    if (k < 0 || steps == 0) return record.qpos0;
-    const long row = std::min<long>(k, steps - 1);
-    return std::vector<double>(record.qpos.begin() + row * record.nq,
-                               record.qpos.begin() + (row + 1) * record.nq);
-  };
-  const PhaseTimes& p = e.phases;
-  const double end = record.steps() * dt;
-  // Every motion gets every column, so columns line up across rows; an event the motion
-  // never reached leaves its tile empty.
-  auto add = [&](const std::string& name, double t) {
-    columns.names.push_back(name);
-    columns.frames.push_back(t < 0 ? std::vector<double>() : frame_at(t));
-  };
-  add("crouch", p.begin[kCrouch]);
-  add("extend", p.begin[kExtend]);
-  add("take-off", p.takeoff());
-  add("rising", p.takeoff() >= 0 && p.peak() >= 0 ? 0.5 * (p.takeoff() + p.peak()) : -1);
-  add("peak", p.peak());
-  add("falling", p.peak() >= 0 && p.landing() >= 0 ? 0.5 * (p.peak() + p.landing()) : -1);
-  add("touch-down", p.landing());
-  add("end", end);
-  return columns;
-}
 
 void write_run_outputs(const RunOutputs& o) {
   const DiversityResult result = o.optimizer.result();
@@ -184,25 +153,8 @@ void write_run_outputs(const RunOutputs& o) {
          o.wall_seconds > 0 ? static_cast<double>(result.evaluations) / o.wall_seconds : 0.0}}}};
   write_json_atomic(o.dir / "summary.json", summary);
 
-  if (!o.render) return;
-  std::vector<FilmRow> rows;
-  std::vector<std::string> names;
-  const auto model = SharedModel::from_file((o.dir / "model" / "m0.xml").string());
-  for (std::size_t i = 0; i < count; ++i) {
-    FilmColumns columns = jump_film_columns(evaluations[i], records[i]);
-    if (columns.names.size() > names.size()) names = columns.names;
-    rows.push_back(FilmRow{model->get(), label(i), std::move(columns.frames)});
-  }
-  FilmStripOptions film;
-  std::string title = ev.task().name + ", metric " + to_string(o.problem.metric()) + ":";
-  for (std::size_t c = 0; c < names.size(); ++c)
-    title += "  " + column_label(static_cast<int>(c)) + " " + names[c];
-  film.title = title;
-  const TaskConstraints& tc = ev.task().constraints;
-  if (tc.landing)
-    film.ground_strips.push_back(
-        {tc.landing_center - tc.landing_half_width, tc.landing_center + tc.landing_half_width});
-  write_film_strip((o.dir / "filmstrip.png").string(), rows, film);
+  // The film strip is drawn from the files just written, as `diverse render` draws it.
+  if (o.render) write_run_film_strip(load_run_view(o.dir), o.dir / "filmstrip.png");
 }
 
 }  // namespace diverse

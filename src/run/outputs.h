@@ -28,12 +28,5 @@ struct RunOutputs {
 
 void write_run_outputs(const RunOutputs& outputs);
 
-// The film strip's columns for one motion: qpos at the phase events of a jump
-// (crouch, extend, take-off, half-way up, peak, half-way down, touch-down, end).
-struct FilmColumns {
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> frames;
-};
-FilmColumns jump_film_columns(const Evaluation& evaluation, const StepRecorder& record);
 
 }  // namespace diverse
