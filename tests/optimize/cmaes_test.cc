@@ -4,6 +4,8 @@
 #include "optimize/cmaes.h"
 
 #include <gtest/gtest.h>
+
+#include "support/cli.h"
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -591,17 +593,8 @@ struct CommandResult {
 };
 
 CommandResult run_command(const std::string& arguments) {
-  const std::string command = std::string(DIVERSE_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t read = 0;
-  while ((read = std::fread(buffer, 1, sizeof buffer, pipe)) > 0)
-    result.output.append(buffer, read);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  const cli_test::CliResult r = cli_test::run_cli(arguments);
+  return {r.status, r.output};
 }
 
 TEST(CmaesCommand, PrintsOneJsonResult) {

@@ -1,5 +1,7 @@
 // Offscreen rendering, images, film strips and videos, on a tiny planar character.
 #include <gtest/gtest.h>
+
+#include "support/cli.h"
 #include <mujoco/mujoco.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -136,15 +138,7 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-std::string run_and_read(const std::string& command) {
-  std::string out;
-  if (FILE* pipe = popen(command.c_str(), "r")) {
-    char buffer[256];
-    while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
-    pclose(pipe);
-  }
-  return out;
-}
+std::string run_and_read(const std::string& command) { return cli_test::shell_output(command); }
 
 // ---------------------------------------------------------------------------- images
 

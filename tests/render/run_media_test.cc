@@ -5,6 +5,8 @@
 #include "render/run_media.h"
 
 #include <gtest/gtest.h>
+
+#include "support/cli.h"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -31,22 +33,8 @@ namespace fs = std::filesystem;
 
 const std::string kTaskFile = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml";
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result run_cli(const std::string& args, const std::string& env = "") {
-  const std::string command = (env.empty() ? "" : "env " + env + " ") + std::string(DIVERSE_BINARY) +
-                              " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[4096];
-  while (pipe && fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = cli_test::CliResult;
+using cli_test::run_cli;
 
 std::string ffprobe_frames(const fs::path& video) {
   const std::string command = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "

@@ -1,6 +1,8 @@
 // End-to-end tests of `diverse run` and `diverse resume` on a short run of a real task:
 // thread-count independence, exact resume after kill -9, and the errors users meet.
 #include <gtest/gtest.h>
+
+#include "support/cli.h"
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,21 +21,8 @@ namespace diverse {
 namespace {
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result run_cli(const std::string& args) {
-  const std::string command = std::string(DIVERSE_BINARY) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[4096];
-  while (pipe && fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using Result = cli_test::CliResult;
+using cli_test::run_cli;
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("diverse_run_test_" + name);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cli.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -171,22 +173,8 @@ TEST(ToyStrategies, ProgressiveAndJointGiveFeasibleSpreadResults) {
 
 // ---- The command line -----------------------------------------------------------------
 
-struct Command {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-Command run(const std::string& args) {
-  Command c;
-  const std::string command = std::string(DIVERSE_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return c;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) c.output += buffer;
-  const int status = pclose(pipe);
-  c.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return c;
-}
+using Command = cli_test::CliResult;
+Command run(const std::string& args) { return cli_test::run_cli(args); }
 
 fs::path temp_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("diverse_toy_test_" + name);
