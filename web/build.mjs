@@ -1,7 +1,7 @@
 // Builds the gallery page template: web/src/gallery.js bundled with three.js (pinned in
 // package-lock.json) into one script with esbuild, then inlined with the stylesheet into
 // web/src/gallery.html. The result is a single HTML file that needs no network; `diverse
-// gallery` puts a run's data in place of its __DIVERSE_GALLERY_DATA__ placeholder.
+// gallery` puts a run's data in place of its __DIVERSE_GALLERY_DATA__ data marker.
 //
 //   node build.mjs [OUT]     (default: dist/gallery-template.html)
 //
@@ -43,7 +43,7 @@ for (const marker of ['/*__GALLERY_STYLE__*/', '/*__GALLERY_SCRIPT__*/', '__DIVE
 }
 html = html.replace('/*__GALLERY_STYLE__*/', () => style).replace('/*__GALLERY_SCRIPT__*/', () => script);
 if (html.split('__DIVERSE_GALLERY_DATA__').length !== 2) {
-  throw new Error('the bundled script contains the data placeholder');
+  throw new Error('the bundled script contains the data data marker');
 }
 await mkdir(dirname(out), { recursive: true });
 await writeFile(`${out}.tmp`, html);

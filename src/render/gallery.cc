@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kPlaceholder = "__DIVERSE_GALLERY_DATA__";
+constexpr const char* kDataMarker = "__DIVERSE_GALLERY_DATA__";
 
 // 4 decimals: 0.1 mm for positions, 1e-4 for unit quaternions and colours.
 double round4(double v) {
@@ -428,10 +428,10 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
 }
 
 std::string gallery_html(const std::string& page_template, const nlohmann::json& data) {
-  const std::size_t at = page_template.find(kPlaceholder);
-  if (at == std::string::npos || page_template.find(kPlaceholder, at + 1) != std::string::npos)
-    throw UserError(std::string("gallery: the page template has no single ") + kPlaceholder +
-                    " placeholder; rebuild it from web/");
+  const std::size_t at = page_template.find(kDataMarker);
+  if (at == std::string::npos || page_template.find(kDataMarker, at + 1) != std::string::npos)
+    throw UserError(std::string("gallery: the page template has no single ") + kDataMarker +
+                    " data marker; rebuild it from web/");
   // JSON inside <script>: "</" would end the element; "<\/" is the same JSON string.
   std::string json = data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   std::string escaped;
@@ -441,7 +441,7 @@ std::string gallery_html(const std::string& page_template, const nlohmann::json&
     if (json[i] == '<' && i + 1 < json.size() && json[i + 1] == '/') escaped += '\\';
   }
   std::string html = page_template;
-  html.replace(at, std::string(kPlaceholder).size(), escaped);
+  html.replace(at, std::string(kDataMarker).size(), escaped);
   return html;
 }
 

@@ -70,7 +70,7 @@ nlohmann::json body_frames_json(const mjModel* model, std::span<const std::vecto
 nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options = {});
 
 // The template with the data put in its place (JSON inside a <script> element, with "</"
-// escaped). Throws UserError if the template lacks the placeholder.
+// escaped). Throws UserError if the template lacks the data marker.
 std::string gallery_html(const std::string& page_template, const nlohmann::json& data);
 
 // Reads the run, makes the data and writes RUN/gallery.html; returns its path.

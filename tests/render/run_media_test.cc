@@ -259,7 +259,7 @@ TEST_F(RunMediaTest, GalleryDataHasPosesConstraintsAndThePath) {
   }
 }
 
-TEST(GalleryHtml, DataReplacesThePlaceholderAndCannotEndTheScript) {
+TEST(GalleryHtml, DataReplacesTheDataMarkerAndCannotEndTheScript) {
   const std::string page = "<script id=d type=application/json>__DIVERSE_GALLERY_DATA__</script>";
   const std::string html = gallery_html(page, {{"name", "</script><b>"}});
   EXPECT_EQ(html, "<script id=d type=application/json>{\"name\":\"<\\/script><b>\"}</script>");
@@ -268,7 +268,7 @@ TEST(GalleryHtml, DataReplacesThePlaceholderAndCannotEndTheScript) {
     FAIL();
   } catch (const UserError& e) {
     EXPECT_STREQ(e.what(), "gallery: the page template has no single __DIVERSE_GALLERY_DATA__ "
-                           "placeholder; rebuild it from web/");
+                           "data marker; rebuild it from web/");
   }
 }
 
