@@ -445,6 +445,26 @@ TEST(FilmStripTest, WritesTwoDifferentRowsOfTheExpectedSize) {
   EXPECT_GT(variance(header), 10.0);
 }
 
+TEST(FilmStripTest, AnEmptyFrameLeavesItsTileEmpty) {
+  // A motion that never reached a column's phase event (e.g. it fell before take-off)
+  // passes an empty qpos there: the tile stays background, the others are drawn.
+  const ModelPtr model = load_model(kTinyModel);
+  auto frames = jump_frames();
+  frames[1].clear();
+  const std::vector<FilmRow> rows = {{model.get(), "M0", frames}};
+  FilmStripOptions options;
+  options.tile_width = 120;
+  options.tile_height = 100;
+  const Image strip = render_film_strip(rows, options);
+  const int label_w = text_width("M0", FontSize::kLarge) + 8;
+  const int grid_x = options.margin + label_w;
+  const int grid_y = options.margin + text_height(FontSize::kLarge) + 4;
+  const Image drawn = crop(strip, grid_x, grid_y, 120, 100);
+  const Image empty = crop(strip, grid_x + 120 + options.gap, grid_y, 120, 100);
+  EXPECT_GT(variance(drawn), 100.0);
+  EXPECT_LT(variance(empty), 1.0);
+}
+
 TEST(FilmStripTest, RowsNeedAModel) {
   const std::vector<FilmRow> rows = {{nullptr, "M0", jump_frames()}};
   EXPECT_THROW(render_film_strip(rows), std::invalid_argument);
