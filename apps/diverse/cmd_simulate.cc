@@ -65,15 +65,8 @@ void run(const SimulateArgs& args) {
     std::vector<FilmRow> rows;
     rows.push_back(FilmRow{model->get(), "M0", std::move(columns.frames)});
     FilmStripOptions film;
-    std::string title = task.name + ":";
-    for (std::size_t c = 0; c < columns.names.size(); ++c) {
-      title += "  " + column_label(static_cast<int>(c)) + " " + columns.names[c];
-    }
-    film.title = title;
-    if (task.constraints.landing) {
-      film.ground_strips.push_back({task.constraints.landing_center - task.constraints.landing_half_width,
-                                    task.constraints.landing_center + task.constraints.landing_half_width});
-    }
+    film.title = film_title(task.name, columns.names);
+    film.ground_strips = task_ground_strips(task);
     write_film_strip((dir / "filmstrip.png").string(), rows, film);
   }
   std::printf("wrote %s\n", (dir / "motion.json").string().c_str());

@@ -1,5 +1,7 @@
 #include "render/film_columns.h"
 
+#include "render/film_strip.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +36,22 @@ FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
   add("touch-down", p.landing());
   add("end", end);
   return columns;
+}
+
+std::string film_title(const std::string& prefix, const std::vector<std::string>& column_names) {
+  std::string title = prefix;
+  title.append(":");
+  for (std::size_t c = 0; c < column_names.size(); ++c)
+    title.append("  ").append(column_label(static_cast<int>(c))).append(" ").append(column_names[c]);
+  return title;
+}
+
+std::vector<GroundStrip> task_ground_strips(const Task& task) {
+  std::vector<GroundStrip> strips;
+  const TaskConstraints& c = task.constraints;
+  if (c.landing)
+    strips.push_back({c.landing_center - c.landing_half_width, c.landing_center + c.landing_half_width});
+  return strips;
 }
 
 }  // namespace diverse

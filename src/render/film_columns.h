@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "physics/rollout.h"
+#include "render/offscreen.h"
 #include "task/evaluate.h"
+#include "task/task.h"
 
 namespace diverse {
 
@@ -17,5 +19,11 @@ struct FilmColumns {
   std::vector<std::vector<double>> frames;
 };
 FilmColumns jump_film_columns(const Evaluation& evaluation, const StepRecorder& record);
+
+// "PREFIX:  A crouch  B extend ...": the title line that names a film strip's columns.
+std::string film_title(const std::string& prefix, const std::vector<std::string>& column_names);
+
+// The parts of the floor a task's pictures mark: its landing region, if it has one.
+std::vector<GroundStrip> task_ground_strips(const Task& task);
 
 }  // namespace diverse

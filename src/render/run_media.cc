@@ -153,11 +153,7 @@ RunView load_run_view(const fs::path& dir) {
   // The landing region comes from the task file; pictures are still worth making without.
   const std::string task_file = view.run.value("task_file", std::string());
   try {
-    const Task task = load_task(task_file);
-    const TaskConstraints& c = task.constraints;
-    if (c.landing)
-      view.ground_strips.push_back(
-          {c.landing_center - c.landing_half_width, c.landing_center + c.landing_half_width});
+    view.ground_strips = task_ground_strips(load_task(task_file));
   } catch (const UserError& e) {
     view.task_note = e.what();
   }
@@ -175,11 +171,7 @@ void write_run_film_strip(const RunView& run, const fs::path& png) {
     rows.push_back(FilmRow{m.model->get(), m.label, std::move(columns.frames)});
   }
   FilmStripOptions film;
-  std::string title = run.task_name;
-  title.append(", metric ").append(run.metric).append(":");
-  for (std::size_t c = 0; c < names.size(); ++c)
-    title.append("  ").append(column_label(static_cast<int>(c))).append(" ").append(names[c]);
-  film.title = title;
+  film.title = film_title(run.task_name + ", metric " + run.metric, names);
   film.ground_strips = run.ground_strips;
   fs::create_directories(png.has_parent_path() ? png.parent_path() : fs::path("."));
   write_film_strip(png.string(), rows, film);

@@ -131,14 +131,12 @@ nlohmann::json without_timing(nlohmann::json summary) {
 
 void start_run(const RunRequest& request) {
   const int threads = resolve_threads(request.threads);
+  RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.options);
   try {
-    validate(request.options.variations == 0
-                 ? [&] { auto o = request.options; o.variations = 1; return o; }()
-                 : request.options);
+    validate(setup.options);  // after the task's N has filled in variations = 0
   } catch (const std::invalid_argument& e) {
     throw UserError(e.what());
   }
-  RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.options);
 
   if (holds_run(request.out)) {
     if (!request.force)
