@@ -26,6 +26,8 @@ struct RunArgs {
   double k = 10.0;
   long long generations = 500;
   std::string strategy = "round-robin";
+  std::string constraints = "dominant";
+  std::string point = "best-sample";
   std::uint64_t seed = 1;
   int threads = 0;
   int popsize = 16;
@@ -50,6 +52,14 @@ void install_run(CLI::App& app) {
   cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")->capture_default_str();
   cmd->add_option("--generations", args->generations, "Generation limit")->capture_default_str();
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
+      ->capture_default_str();
+  cmd->add_option("--constraints", args->constraints,
+                  "dominant (a violating sample ranks below every feasible one) or penalty "
+                  "(eq. 1 literally: -C inside D)")
+      ->capture_default_str();
+  cmd->add_option("--point", args->point,
+                  "Where a variation stands between its steps: best-sample (its best sample "
+                  "so far) or mean (its CMA mean, as in the paper)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
   cmd->add_option("--threads", args->threads, "Worker threads (0 = one per core)")
@@ -91,6 +101,8 @@ void install_run(CLI::App& app) {
     request.options.k = a.k;
     request.options.max_generations = a.generations;
     request.options.strategy = parse_strategy(a.strategy);
+    request.options.constraints = parse_constraint_rule(a.constraints);
+    request.options.point = parse_variation_point(a.point);
     request.options.seed = a.seed;
     request.options.popsize = a.popsize;
     request.options.sigma0 = a.sigma0;

@@ -31,6 +31,7 @@ struct ToyArgs {
   std::string out;
   long long generations = 200;
   std::string strategy = "round-robin";
+  std::string constraints = "penalty";
   int threads = 1;
   bool paths = true;
   int seeds = 1;
@@ -144,6 +145,7 @@ void run_toy(const ToyArgs& args) {
   options.variations = args.n;
   options.max_generations = args.generations;
   options.strategy = parse_strategy(args.strategy, "--strategy");
+  options.constraints = parse_constraint_rule(args.constraints, "--constraints");
   const std::filesystem::path out(args.out);
   ensure_writable_directory(out);
 
@@ -211,6 +213,10 @@ void add_toy(CLI::App& app) {
   cmd->add_option("--out", args->out, "output directory")->required();
   cmd->add_option("--generations", args->generations, "generation limit")->capture_default_str();
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
+      ->capture_default_str();
+  cmd->add_option("--constraints", args->constraints,
+                  "dominant (a violating sample ranks below every feasible one) or penalty "
+                  "(eq. 1 literally: -C inside D)")
       ->capture_default_str();
   cmd->add_option("--threads", args->threads, "worker threads")->capture_default_str();
   cmd->add_option("--seeds", args->seeds,

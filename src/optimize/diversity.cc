@@ -12,7 +12,7 @@ namespace diverse {
 namespace {
 
 constexpr const char* kCheckpointFormat = "diverse.diversity_checkpoint";
-constexpr int kCheckpointVersion = 1;
+constexpr int kCheckpointVersion = 2;
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
@@ -97,6 +97,36 @@ DiversityStrategy parse_strategy(const std::string& name, const std::string& whe
   throw UserError(where + ": expected one of round-robin, progressive, joint, got '" + name + "'");
 }
 
+const char* to_string(ConstraintRule rule) {
+  switch (rule) {
+    case ConstraintRule::kDominant: return "dominant";
+    case ConstraintRule::kPenalty: return "penalty";
+  }
+  return "?";
+}
+
+const char* to_string(VariationPoint point) {
+  switch (point) {
+    case VariationPoint::kBestSample: return "best-sample";
+    case VariationPoint::kMean: return "mean";
+  }
+  return "?";
+}
+
+VariationPoint parse_variation_point(const std::string& name, const std::string& where) {
+  for (VariationPoint p : {VariationPoint::kBestSample, VariationPoint::kMean}) {
+    if (name == to_string(p)) return p;
+  }
+  throw UserError(where + ": expected one of best-sample, mean, got '" + name + "'");
+}
+
+ConstraintRule parse_constraint_rule(const std::string& name, const std::string& where) {
+  for (ConstraintRule r : {ConstraintRule::kDominant, ConstraintRule::kPenalty}) {
+    if (name == to_string(r)) return r;
+  }
+  throw UserError(where + ": expected one of dominant, penalty, got '" + name + "'");
+}
+
 const char* to_string(DiversityStop stop) {
   switch (stop) {
     case DiversityStop::kNone: return "none";
@@ -122,7 +152,9 @@ void validate(const DiversityOptions& o) {
 
 nlohmann::json to_json(const DiversityOptions& o) {
   return {{"variations", o.variations},         {"k", o.k},
-          {"strategy", to_string(o.strategy)},  {"popsize", o.popsize},
+          {"strategy", to_string(o.strategy)},  {"constraints", to_string(o.constraints)},
+          {"point", to_string(o.point)},
+          {"popsize", o.popsize},
           {"sigma0", o.sigma0},                 {"max_generations", o.max_generations},
           {"window", o.window},                 {"epsilon", o.epsilon},
           {"seed", o.seed}};
@@ -133,6 +165,8 @@ DiversityOptions diversity_options_from_json(const nlohmann::json& j) {
   o.variations = j.at("variations").get<int>();
   o.k = j.at("k").get<double>();
   o.strategy = parse_strategy(j.at("strategy").get<std::string>(), "strategy");
+  o.constraints = parse_constraint_rule(j.at("constraints").get<std::string>(), "constraints");
+  o.point = parse_variation_point(j.at("point").get<std::string>(), "point");
   o.popsize = j.at("popsize").get<int>();
   o.sigma0 = j.at("sigma0").get<double>();
   o.max_generations = j.at("max_generations").get<long long>();
@@ -200,7 +234,63 @@ DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
   }
   rescore();
   best_ = Snapshot{points_, outcomes_, current_};
-  best_history_.push_back(best_.score.D);
+  best_history_.push_back(merit(best_.score));
+}
+
+DiversityOptimizer::Merit DiversityOptimizer::merit(const DiversityScore& score) const {
+  Merit m;
+  m.D = score.D;
+  if (options_.constraints == ConstraintRule::kDominant) m.violation = score.constraint.sum();
+  return m;
+}
+
+bool DiversityOptimizer::better(const Merit& a, const Merit& b) const {
+  if (a.violation != b.violation) return a.violation < b.violation;
+  return a.D > b.D;
+}
+
+std::size_t DiversityOptimizer::best_candidate(const std::vector<double>& constraint,
+                                               const std::vector<double>& D) const {
+  // The last candidate is the incumbent; it wins ties, so a point only moves to improve.
+  std::size_t best = D.size() - 1;
+  for (std::size_t k = 0; k + 1 < D.size(); ++k) {
+    if (better(Merit{options_.constraints == ConstraintRule::kDominant ? constraint[k] : 0.0, D[k]},
+               Merit{options_.constraints == ConstraintRule::kDominant ? constraint[best] : 0.0,
+                     D[best]})) {
+      best = k;
+    }
+  }
+  return best;
+}
+
+std::vector<double> DiversityOptimizer::fitness(const std::vector<double>& constraint,
+                                                const std::vector<double>& D) const {
+  // CMA-ES minimizes.
+  std::vector<double> f(D.size());
+  for (std::size_t k = 0; k < D.size(); ++k) f[k] = -D[k];
+  if (options_.constraints == ConstraintRule::kPenalty) return f;
+  // Dominant: every infeasible sample above (worse than) every feasible one, in the
+  // order of its C. Ranks, not C itself, so that no C is lost to rounding beside a large
+  // D; CMA-ES only uses the order.
+  double worst_feasible = 0.0;
+  std::vector<double> violations;
+  for (std::size_t k = 0; k < D.size(); ++k) {
+    if (constraint[k] > 0.0) {
+      violations.push_back(constraint[k]);
+    } else {
+      worst_feasible = std::max(worst_feasible, f[k]);
+    }
+  }
+  std::sort(violations.begin(), violations.end());
+  violations.erase(std::unique(violations.begin(), violations.end()), violations.end());
+  for (std::size_t k = 0; k < D.size(); ++k) {
+    if (constraint[k] > 0.0) {
+      const auto rank = std::lower_bound(violations.begin(), violations.end(), constraint[k]) -
+                        violations.begin();
+      f[k] = worst_feasible + 1.0 + static_cast<double>(rank);
+    }
+  }
+  return f;
 }
 
 CmaesOptions DiversityOptimizer::cma_options(int dim, int instance) const {
@@ -270,18 +360,31 @@ void DiversityOptimizer::step_variation(int v) {
   // The previous step's new mean rides along with this step's samples, so that its
   // single evaluation does not leave the other workers idle.
   std::vector<Eigen::VectorXd> batch = xs;
-  if (pending_ > 0) batch.push_back(points_[pending_]);
+  if (pending_ > 0) batch.push_back(points_[pending_]);  // only with VariationPoint::kMean
   const auto outcomes = evaluate_all(*problem_, *pool_, batch);
   if (pending_ > 0) settle_pending(outcomes.back());
   evaluations_ += static_cast<long long>(xs.size());
 
-  // Each sample replaces M_v in the current set; CMA minimizes, so it is told -D.
-  std::vector<double> fitness(xs.size());
+  // Each sample replaces M_v in the current set and is ranked by its D and its own C.
+  std::vector<double> D(xs.size()), C(xs.size());
   pool_->parallel_for(xs.size(), [&](std::size_t k, int) {
-    fitness[k] = -replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
+    D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
+    C[k] = scored_constraint(*outcomes[k]);
   });
-  es.tell(fitness);
+  es.tell(fitness(C, D));
 
+  if (options_.point == VariationPoint::kBestSample) {
+    // M_v becomes this generation's best sample if it beats M_v as it stands.
+    D.push_back(current_.D);
+    C.push_back(current_.constraint[v]);
+    const std::size_t best = best_candidate(C, D);
+    if (best < xs.size()) {
+      points_[v] = xs[best];
+      outcomes_[v] = outcomes[best];
+    }
+    finish_step(v);
+    return;
+  }
   // The new mean is what the other variations' samples are scored against from now on;
   // it is evaluated with the next batch (or at the end of the generation).
   points_[v] = es.mean();
@@ -311,14 +414,29 @@ void DiversityOptimizer::step_joint() {
     outcomes[index] = checked(problem_->evaluate(xs[k].segment(v * dim, dim), worker));
   });
   evaluations_ += static_cast<long long>(lambda * n);
-  std::vector<double> fitness(lambda);
+  std::vector<double> D(lambda), C(lambda);
   pool_->parallel_for(lambda, [&](std::size_t k, int) {
     std::vector<std::shared_ptr<const Outcome>> set{outcomes_.front()};
     set.insert(set.end(), outcomes.begin() + k * n, outcomes.begin() + (k + 1) * n);
-    fitness[k] = -score_diversity(*problem_, set, options_.k).D;
+    const DiversityScore score = score_diversity(*problem_, set, options_.k);
+    D[k] = score.D;
+    C[k] = score.constraint.tail(n).sum();
   });
-  es.tell(fitness);
+  es.tell(fitness(C, D));
 
+  if (options_.point == VariationPoint::kBestSample) {
+    D.push_back(current_.D);
+    C.push_back(current_.constraint.tail(n).sum());
+    const std::size_t best = best_candidate(C, D);
+    if (best < lambda) {
+      for (int v = 1; v <= n; ++v) {
+        points_[v] = xs[best].segment((v - 1) * dim, dim);
+        outcomes_[v] = outcomes[best * n + v - 1];
+      }
+    }
+    finish_step(0);
+    return;
+  }
   const Eigen::VectorXd mean = es.mean();
   std::vector<Eigen::VectorXd> means;
   for (int v = 1; v <= n; ++v) means.push_back(mean.segment((v - 1) * dim, dim));
@@ -334,7 +452,7 @@ void DiversityOptimizer::step_joint() {
 void DiversityOptimizer::finish_step(int variation) {
   ++steps_;
   rescore();
-  if (current_.D > best_.score.D) best_ = Snapshot{points_, outcomes_, current_};
+  if (better(merit(current_), merit(best_.score))) best_ = Snapshot{points_, outcomes_, current_};
 
   DiversityRecord record;
   record.generation = generation_;
@@ -359,11 +477,14 @@ void DiversityOptimizer::finish_step(int variation) {
 
 void DiversityOptimizer::end_generation() {
   if (pending_ > 0) settle_pending(evaluate_all(*problem_, *pool_, {points_[pending_]}).front());
-  best_history_.push_back(best_.score.D);
+  best_history_.push_back(merit(best_.score));
   const int window = options_.window;
+  // Stagnation: over the window, the best set neither lost violation nor gained epsilon D.
   auto stagnated = [&](long long since) {
-    return window > 0 && generation_ - since >= window &&
-           best_.score.D - best_history_[generation_ - window] < options_.epsilon;
+    if (window <= 0 || generation_ - since < window) return false;
+    const Merit& now = best_history_.back();
+    const Merit& then = best_history_[generation_ - window];
+    return now.violation >= then.violation && now.D - then.D < options_.epsilon;
   };
 
   if (options_.strategy != DiversityStrategy::kProgressive) {
@@ -405,7 +526,7 @@ void DiversityOptimizer::end_generation() {
   phase_budget_ = std::max<long long>(1, left / (options_.variations - active_ + 1));
   rescore();
   best_ = Snapshot{points_, outcomes_, current_};
-  best_history_.back() = best_.score.D;
+  best_history_.back() = merit(best_.score);
 }
 
 DiversityResult DiversityOptimizer::result() const {
@@ -443,7 +564,9 @@ nlohmann::json DiversityOptimizer::checkpoint() const {
   j["points"] = points_json(points_);
   j["current_D"] = current_.D;
   j["best"] = {{"points", points_json(best_.points)}, {"D", best_.score.D}};
-  j["best_history"] = best_history_;
+  nlohmann::json history = nlohmann::json::array();
+  for (const Merit& m : best_history_) history.push_back({m.violation, m.D});
+  j["best_history"] = std::move(history);
   nlohmann::json log = nlohmann::json::array();
   for (const auto& r : log_) log.push_back(to_json(r));
   j["log"] = std::move(log);
@@ -491,7 +614,9 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
     for (const auto& state : j.at("cma")) opt.cmas_.push_back(Cmaes::from_json(state));
     opt.points_ = points_from_json(j.at("points"));
     opt.best_.points = points_from_json(j.at("best").at("points"));
-    opt.best_history_ = j.at("best_history").get<std::vector<double>>();
+    for (const auto& m : j.at("best_history")) {
+      opt.best_history_.push_back(Merit{m.at(0).get<double>(), m.at(1).get<double>()});
+    }
     for (const auto& r : j.at("log")) opt.log_.push_back(record_from_json(r));
     for (const auto& path : j.at("paths")) {
       std::vector<PathPoint> p;

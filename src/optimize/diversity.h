@@ -6,9 +6,9 @@
 //
 //   round-robin  (the paper's method, default) N CMA-ES instances, one per variation,
 //                all starting at P_0. Variation i gets one CMA generation of lambda
-//                samples while the others stay at their current means; each sample is
-//                scored by the full D with M_i replaced by the sample (CMA minimizes
-//                -D); then variation i+1, and so on.
+//                samples while the others stay where they stand (see "Where a variation
+//                stands" below); each sample is scored by the full D with M_i replaced
+//                by the sample; then variation i+1, and so on.
 //   progressive  (baseline, paper section 9) variations are added one at a time; only
 //                the newest is optimized, against M_0 and the earlier ones, until it stops
 //                improving or its share of the generation budget ends; it is then frozen
@@ -23,21 +23,50 @@
 //   joint        one CMA generation (lambda samples, each N evaluations) of the joint
 //                instance.
 // A "step" is one CMA generation of one instance; the log has one record per step.
-// On top of the sample evaluations, the mean of every instance that moved is evaluated
-// again (one evaluation per variation per step): its outcome is what the other variations'
-// samples are scored against. `evaluations` counts both. That evaluation is batched with
-// the next step's samples, so a step's log record and callback come once it is known.
+// With VariationPoint::kMean, on top of the sample evaluations, the mean of every instance
+// that moved is evaluated again (one evaluation per variation per step): its outcome is
+// what the other variations' samples are scored against. `evaluations` counts both. That
+// evaluation is batched with the next step's samples, so a step's log record and callback
+// come once it is known.
 //
 // Termination, checked at the end of each generation: the generation limit; stagnation
-// (the best D improved by less than epsilon over the last `window` generations); or every
+// (over the last `window` generations the best set's D improved by less than epsilon and,
+// under the dominant rule below, its total C did not fall); or every
 // CMA instance stopped on its own numerical criteria (condition number, no-effect axis;
 // its TolFun / TolX are disabled because D moves under it as the other variations move).
 // Progressive: each phase ends on stagnation within the phase or when its share of the
 // budget, (max_generations - generations used) / (variations still to add), at least 1,
 // is used up; the run ends when the last variation's phase ends.
 //
-// The result is the best set seen: after every step the current set (P_0 and every
-// variation's current mean) is scored, and the one with the highest D is kept.
+// Constraints. Eq. 1 puts -C(M_i) inside D with a penalty weight the paper chooses "large
+// enough to rapidly dominate the diversity objective once constraints are violated", and
+// notes that since CMA-ES only ranks samples, the exact weight does not matter once it is
+// large enough. Two rules:
+//   dominant  (default) the limit of a large enough weight: the constraint decides first.
+//             A sample that violates its constraints ranks below every sample that meets
+//             them, infeasible samples rank by their C, and feasible ones by D. For
+//             round-robin and progressive a sample's C is that of the one motion it
+//             changes; for joint, the sum over its N motions. Sets (the best set, the
+//             stagnation test) compare the same way: smaller total C first, then D.
+//   penalty   eq. 1 literally, -C added to D: C competes with the distance terms at the
+//             weight the task gives it, so diversity can buy constraint violation when
+//             the metric's scale is large (a mass-weighted distance summed over 20 poses
+//             of an 80 kg body easily is); the toy of paper figure 2 uses it.
+// D itself (logged, reported) is always eq. 1 as printed.
+//
+// Where a variation stands. The paper scores each sample against the other variations
+// "at their current means". A CMA mean is the weighted average of the generation's best
+// samples, and when the region that meets the task is thin (a landing box, a backflip
+// that must come round) that average is often outside it even when every sample it
+// averages is inside. So by default a variation stands at its best sample:
+//   best-sample  (default) after each of its steps, M_i becomes the generation's best
+//                sample if that beats M_i as it stands, both ranked as above against the
+//                current other variations (an elitist choice on top of CMA-ES, which
+//                itself still adapts from all its samples as usual). No extra evaluation.
+//   mean         the paper's literal choice: M_i is the CMA mean, evaluated once more.
+//
+// The result is the best set seen: after every step the current set (P_0 and where every
+// variation stands) is scored, and the best one under the rule above is kept.
 //
 // Determinism. CMA instance v (1..N; 0 for joint) draws from derive_seed(seed, {v}); a
 // generation's samples are drawn before any is evaluated, evaluated in parallel on the
@@ -63,6 +92,19 @@
 namespace diverse {
 
 enum class DiversityStrategy { kRoundRobin, kProgressive, kJoint };
+enum class ConstraintRule { kDominant, kPenalty };
+enum class VariationPoint { kBestSample, kMean };
+// "best-sample", "mean".
+const char* to_string(VariationPoint point);
+// Parses the names above; throws UserError "WHERE: expected one of best-sample, mean, got
+// 'NAME'".
+VariationPoint parse_variation_point(const std::string& name, const std::string& where = "--point");
+// "dominant", "penalty".
+const char* to_string(ConstraintRule rule);
+// Parses the names above; throws UserError "WHERE: expected one of dominant, penalty, got
+// 'NAME'".
+ConstraintRule parse_constraint_rule(const std::string& name,
+                                     const std::string& where = "--constraints");
 // "round-robin", "progressive", "joint".
 const char* to_string(DiversityStrategy strategy);
 // Parses the names above; throws UserError "WHERE: expected one of round-robin,
@@ -73,6 +115,8 @@ struct DiversityOptions {
   int variations = 4;               // N >= 1, variations besides M_0
   double k = 10.0;                  // K >= 0, weight of the dmin term (paper: 10)
   DiversityStrategy strategy = DiversityStrategy::kRoundRobin;
+  ConstraintRule constraints = ConstraintRule::kDominant;  // see the header comment
+  VariationPoint point = VariationPoint::kBestSample;      // see the header comment
   int popsize = 16;                 // lambda >= 2, samples per CMA generation (paper: 16)
   double sigma0 = 0.1;              // > 0, initial CMA step size, normalized units
   long long max_generations = 500;  // >= 1, generation limit (paper: 500-1000)
@@ -91,14 +135,14 @@ struct DiversityRecord {
   long long step = 0;          // 1-based count of steps over all instances
   int variation = 0;           // variation optimized, 1..N; 0 = all (joint)
   double D = 0.0;              // D of the current set after the step
-  double best_D = 0.0;         // highest D of any set so far (in this phase for progressive)
+  double best_D = 0.0;         // D of the best set so far (in this phase for progressive)
   Eigen::VectorXd constraint;  // C(M_i) of the current set, i = 0..(motions present - 1)
   Eigen::VectorXd dmin;        // dmin(M_i) of the current set, same indexing
   long long evaluations = 0;   // evaluations so far, including this step's
 };
 nlohmann::json to_json(const DiversityRecord& record);
 
-// A point of a variation's optimization path: its CMA mean after one of its steps.
+// A point of a variation's optimization path: where it stands after one of its steps.
 struct PathPoint {
   long long generation = 0;  // 0 for the start at P_0
   long long step = 0;
@@ -149,7 +193,7 @@ class DiversityOptimizer {
   const std::vector<DiversityRecord>& log() const { return log_; }
   // paths()[v] for v = 1..N (paths()[0] holds P_0 alone).
   const std::vector<std::vector<PathPoint>>& paths() const { return paths_; }
-  // The current set (P_0 and the variations' current means) and its score. Progressive:
+  // The current set (P_0 and where each variation stands) and its score. Progressive:
   // only the motions added so far.
   const std::vector<Eigen::VectorXd>& current_parameters() const { return points_; }
   const DiversityScore& current_score() const { return current_; }
@@ -162,6 +206,22 @@ class DiversityOptimizer {
   nlohmann::json checkpoint() const;
 
  private:
+  // How good a set is: its total constraint value (dominant rule; 0 under penalty) and D.
+  struct Merit {
+    double violation = 0.0;
+    double D = 0.0;
+  };
+  Merit merit(const DiversityScore& score) const;
+  // a is strictly better than b: less violation, or as much and a higher D.
+  bool better(const Merit& a, const Merit& b) const;
+  // Index of the best of several candidates by their C and D; the last one is the
+  // incumbent and wins ties.
+  std::size_t best_candidate(const std::vector<double>& constraint,
+                             const std::vector<double>& D) const;
+  // CMA fitness (lower is better) of samples with their C values and D values.
+  std::vector<double> fitness(const std::vector<double>& constraint,
+                              const std::vector<double>& D) const;
+
   struct Snapshot {
     std::vector<Eigen::VectorXd> points;
     std::vector<std::shared_ptr<const Outcome>> outcomes;
@@ -189,7 +249,7 @@ class DiversityOptimizer {
   std::vector<std::shared_ptr<const Outcome>> outcomes_;  // their outcomes
   DiversityScore current_;                               // score of the present motions
   Snapshot best_;
-  std::vector<double> best_history_;  // best D at the end of each generation (0 = start)
+  std::vector<Merit> best_history_;  // best set's merit after each generation (0 = start)
 
   long long generation_ = 0;
   long long steps_ = 0;

@@ -25,8 +25,8 @@ struct PointOutcome : Outcome {
 // (a simulation that blew up). Counts evaluations.
 class BallProblem : public DiversityProblem {
  public:
-  BallProblem(int dim, double radius, double fail_above = 2.0)
-      : dim_(dim), radius_(radius), fail_above_(fail_above) {}
+  BallProblem(int dim, double radius, double fail_above = 2.0, double weight = 5000.0)
+      : dim_(dim), radius_(radius), fail_above_(fail_above), weight_(weight) {}
   int dim() const override { return dim_; }
   Eigen::VectorXd reference() const override { return Eigen::VectorXd::Constant(dim_, 0.4); }
   std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int) const override {
@@ -39,7 +39,7 @@ class BallProblem : public DiversityProblem {
       return out;
     }
     const double e = std::max(0.0, (x - reference()).norm() - radius_);
-    out->constraint = 5000.0 * e * e;
+    out->constraint = weight_ * e * e;
     return out;
   }
   double distance(const Outcome& a, const Outcome& b) const override {
@@ -52,6 +52,7 @@ class BallProblem : public DiversityProblem {
   int dim_;
   double radius_;
   double fail_above_;
+  double weight_;
 };
 
 // A fixed outcome for objective tests.
@@ -149,6 +150,18 @@ TEST(DiversityOptions, StrategyNames) {
   }
 }
 
+TEST(DiversityOptions, ConstraintRuleNames) {
+  EXPECT_EQ(parse_constraint_rule("dominant"), ConstraintRule::kDominant);
+  EXPECT_EQ(parse_constraint_rule("penalty"), ConstraintRule::kPenalty);
+  EXPECT_EQ(DiversityOptions{}.constraints, ConstraintRule::kDominant);
+  try {
+    parse_constraint_rule("soft");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "--constraints: expected one of dominant, penalty, got 'soft'");
+  }
+}
+
 TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
   DiversityOptions o;
   EXPECT_NO_THROW(validate(o));
@@ -178,18 +191,127 @@ TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
   o.variations = 7;
   o.k = 3.25;
   o.strategy = DiversityStrategy::kJoint;
+  o.constraints = ConstraintRule::kPenalty;
+  o.point = VariationPoint::kMean;
   o.seed = 0xfedcba9876543210ULL;
   const DiversityOptions back = diversity_options_from_json(to_json(o));
   EXPECT_EQ(to_json(back), to_json(o));
   EXPECT_EQ(back.seed, o.seed);
 }
 
+// ---- Constraint rules ------------------------------------------------------------------
+
+// A constraint weight of 1 is far too weak for the distances of points spread over the
+// unit square: under the penalty rule diversity buys violation, under the dominant rule
+// it cannot, whatever the strategy.
+class ConstraintRules : public ::testing::TestWithParam<DiversityStrategy> {};
+
+TEST_P(ConstraintRules, DominantKeepsTheResultFeasibleWherePenaltyDoesNot) {
+  const BallProblem weak(2, 0.1, 2.0, /*weight=*/1.0);
+  ThreadPool pool(1);
+  DiversityOptions o;
+  o.variations = 3;
+  o.strategy = GetParam();
+  o.max_generations = 90;
+  o.window = 0;
+  o.seed = 5;
+
+  o.constraints = ConstraintRule::kPenalty;
+  DiversityOptimizer penalty(weak, o, pool);
+  penalty.run();
+  EXPECT_GT(penalty.result().score.constraint.maxCoeff(), 0.0);
+
+  o.constraints = ConstraintRule::kDominant;
+  DiversityOptimizer dominant(weak, o, pool);
+  dominant.run();
+  const DiversityResult r = dominant.result();
+  EXPECT_EQ(r.score.constraint.maxCoeff(), 0.0);
+  // Feasible, and spread: every variation left M_0 by a good part of the ball's radius.
+  for (int i = 1; i < r.score.dmin.size(); ++i) EXPECT_GT(r.score.dmin[i], 0.05 * 0.05) << i;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllStrategies, ConstraintRules,
+                         ::testing::Values(DiversityStrategy::kRoundRobin,
+                                           DiversityStrategy::kProgressive,
+                                           DiversityStrategy::kJoint),
+                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
+                           std::string name = to_string(p.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
+// ---- Where a variation stands ------------------------------------------------------------
+
+// Best-sample: no evaluation beyond the samples, every variation stands at P_0 or at one
+// of its own evaluated samples, and since a variation only moves to a candidate that beats
+// where it stands (the others held still), the current set never gets worse from one step
+// to the next: its total C never rises and, at equal C, its D never falls.
+class BestSample : public ::testing::TestWithParam<DiversityStrategy> {};
+
+TEST_P(BestSample, StandsOnEvaluatedSamplesAndNeverWorsensTheSet) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(2);
+  DiversityOptions o;
+  o.variations = 3;
+  o.strategy = GetParam();
+  o.max_generations = 12;
+  o.window = 0;
+  o.seed = 11;
+  ASSERT_EQ(o.point, VariationPoint::kBestSample);  // the default
+  DiversityOptimizer opt(problem, o, pool);
+  std::vector<std::vector<Eigen::VectorXd>> standing;
+  opt.set_callback([&](const DiversityRecord&) { standing.push_back(opt.current_parameters()); });
+  opt.run();
+  EXPECT_EQ(opt.evaluations(), 1 + 12 * 3 * 16);
+  EXPECT_EQ(opt.evaluations(), problem.evaluations.load());
+  const auto& log = opt.log();
+  ASSERT_FALSE(log.empty());
+  for (std::size_t s = 1; s < log.size(); ++s) {
+    const double before = log[s - 1].constraint.sum(), after = log[s].constraint.sum();
+    EXPECT_LE(after, before) << "step " << s;
+    if (after == before && GetParam() != DiversityStrategy::kProgressive) {
+      EXPECT_GE(log[s].D, log[s - 1].D) << "step " << s;
+    }
+  }
+  // Every point stood on is P_0 or lies in [0, 1]^2 (a reflected CMA sample), and the
+  // result is the best set, all feasible here since P_0 is.
+  for (const auto& set : standing) {
+    for (const auto& x : set) EXPECT_TRUE((x.array() >= 0.0).all() && (x.array() <= 1.0).all());
+  }
+  EXPECT_EQ(opt.result().score.constraint.maxCoeff(), 0.0);
+  EXPECT_GT(opt.result().score.D, 1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllStrategies, BestSample,
+                         ::testing::Values(DiversityStrategy::kRoundRobin,
+                                           DiversityStrategy::kProgressive,
+                                           DiversityStrategy::kJoint),
+                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
+                           std::string name = to_string(p.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
+TEST(DiversityOptions, VariationPointNames) {
+  EXPECT_EQ(parse_variation_point("best-sample"), VariationPoint::kBestSample);
+  EXPECT_EQ(parse_variation_point("mean"), VariationPoint::kMean);
+  try {
+    parse_variation_point("median");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "--point: expected one of best-sample, mean, got 'median'");
+  }
+}
+
 // ---- Strategies ------------------------------------------------------------------------
 
+// The paper's literal bookkeeping (variations stand at their CMA means), whose evaluation
+// counts the tests below spell out; best-sample has tests of its own.
 DiversityOptions small_options(DiversityStrategy strategy, long long generations) {
   DiversityOptions o;
   o.variations = 3;
   o.strategy = strategy;
+  o.point = VariationPoint::kMean;
   o.max_generations = generations;
   o.window = 0;
   o.seed = 7;
@@ -231,7 +353,8 @@ TEST(DiversityRoundRobin, OneGenerationStepsEveryVariationInTurn) {
     EXPECT_EQ(opt.paths()[v].back().x, opt.current_parameters()[v]);
   }
 
-  // The last record describes the current set; the result is the best set ever scored.
+  // The last record describes the current set; the result is the best set ever scored
+  // (dominant rule: least total C first, then highest D).
   const DiversityScore current = score_diversity(
       problem, {problem.evaluate(opt.current_parameters()[0], 0),
                 problem.evaluate(opt.current_parameters()[1], 0),
@@ -240,8 +363,13 @@ TEST(DiversityRoundRobin, OneGenerationStepsEveryVariationInTurn) {
       o.k);
   EXPECT_EQ(opt.log().back().D, current.D);
   const DiversityResult result = opt.result();
+  double least_violation = std::numeric_limits<double>::infinity();
+  for (const auto& r : opt.log()) least_violation = std::min(least_violation, r.constraint.sum());
   double best = -std::numeric_limits<double>::infinity();
-  for (const auto& r : opt.log()) best = std::max(best, r.D);
+  for (const auto& r : opt.log()) {
+    if (r.constraint.sum() == least_violation) best = std::max(best, r.D);
+  }
+  EXPECT_EQ(result.score.constraint.sum(), least_violation);
   EXPECT_EQ(result.score.D, best);
   EXPECT_EQ(result.score.D, score_diversity(problem, result.outcomes, o.k).D);
   EXPECT_EQ(result.parameters.size(), 4u);
@@ -378,7 +506,10 @@ class DiversityStrategies : public ::testing::TestWithParam<DiversityStrategy> {
 
 TEST_P(DiversityStrategies, BitIdenticalForOneTwoAndThreeThreads) {
   const BallProblem problem(3, 0.3);
+  for (VariationPoint point : {VariationPoint::kMean, VariationPoint::kBestSample}) {
+  SCOPED_TRACE(to_string(point));
   DiversityOptions o = small_options(GetParam(), 24);
+  o.point = point;
   o.window = 10;
   ThreadPool one(1), two(2), three(3);
   DiversityOptimizer a(problem, o, one), b(problem, o, two), c(problem, o, three);
@@ -392,11 +523,15 @@ TEST_P(DiversityStrategies, BitIdenticalForOneTwoAndThreeThreads) {
   DiversityOptimizer d(problem, o, one);
   d.run();
   EXPECT_NE(a.result().score.D, d.result().score.D);
+  }
 }
 
 TEST_P(DiversityStrategies, CheckpointResumeMatchesUninterruptedRun) {
   const BallProblem problem(3, 0.3);
-  const DiversityOptions o = small_options(GetParam(), 24);  // progressive: phases of 8
+  for (VariationPoint point : {VariationPoint::kMean, VariationPoint::kBestSample}) {
+  SCOPED_TRACE(to_string(point));
+  DiversityOptions o = small_options(GetParam(), 24);  // progressive: phases of 8
+  o.point = point;
   ThreadPool one(1), two(2);
   DiversityOptimizer whole(problem, o, one);
   whole.run();
@@ -418,6 +553,7 @@ TEST_P(DiversityStrategies, CheckpointResumeMatchesUninterruptedRun) {
       DiversityOptimizer::from_checkpoint(problem, whole.checkpoint(), one);
   EXPECT_TRUE(done.done());
   EXPECT_EQ(done.result().score.D, whole.result().score.D);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(All, DiversityStrategies,

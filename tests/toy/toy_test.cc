@@ -94,7 +94,8 @@ struct Figures {
   std::vector<double> clustering, reach, outside;  // per seed; outside = farthest point's e
 };
 
-Figures measure(double k, DiversityStrategy strategy, int seeds) {
+Figures measure(double k, DiversityStrategy strategy, int seeds,
+                ConstraintRule rule = ConstraintRule::kPenalty) {
   const ToyProblem problem;
   ThreadPool pool(1);
   Figures f;
@@ -103,6 +104,7 @@ Figures measure(double k, DiversityStrategy strategy, int seeds) {
     o.k = k;
     o.seed = static_cast<std::uint64_t>(s);
     o.strategy = strategy;
+    o.constraints = rule;
     o.max_generations = 200;
     DiversityOptimizer opt(problem, o, pool);
     opt.run();
@@ -160,6 +162,17 @@ TEST(ToyFigure2, KHundredOverpowersTheConstraint) {
   EXPECT_GT(lowest(f100.outside), 0.03);
   EXPECT_GT(lowest(f100.outside), 5.0 * highest(f10.outside));
   EXPECT_GT(median(f100.clustering), 0.8);  // still spread
+}
+
+// Under the dominant rule no amount of diversity buys a violation: with K = 100 every
+// point stays inside the region (C = 0 exactly), yet the points still spread.
+TEST(ToyDominantRule, KeepsEveryPointInsideEvenAtKHundred) {
+  for (double k : {10.0, 100.0}) {
+    const Figures f = measure(k, DiversityStrategy::kRoundRobin, 4, ConstraintRule::kDominant);
+    EXPECT_EQ(highest(f.outside), 0.0) << "K = " << k;
+    EXPECT_GT(median(f.clustering), 0.7) << "K = " << k;
+    EXPECT_GT(median(f.reach), 0.7) << "K = " << k;
+  }
 }
 
 TEST(ToyStrategies, ProgressiveAndJointGiveFeasibleSpreadResults) {
