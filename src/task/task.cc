@@ -271,6 +271,11 @@ void read_seed(const Reader& r, Task& task) {
   s.robustness = r.number("robustness", 0, 1e6, s.robustness);
 }
 
+void read_diversity(const Reader& r, Task& task) {
+  r.only({"sigma0"});
+  task.diversity.sigma0 = r.number("sigma0", 1e-4, 1, task.diversity.sigma0);
+}
+
 }  // namespace
 
 const SceneObject* Task::find_object(const std::string& object_name) const {
@@ -294,7 +299,7 @@ Task load_task(const std::string& path) {
   task.file = path;
   Reader r(path, root, "");
   r.only({"name", "description", "character", "metric", "variations", "m0", "controller",
-          "simulation", "objects", "constraints", "seed"});
+          "simulation", "objects", "constraints", "seed", "diversity"});
   task.name = r.string("name");
   if (task.name.empty()) r.fail("name", "expected a non-empty string");
   task.description = r.string("description", "");
@@ -310,6 +315,7 @@ Task load_task(const std::string& path) {
   if (auto t = r.table("simulation", false)) read_simulation(r.sub("simulation", *t), task);
   read_constraints(r.sub("constraints", *r.table("constraints", true)), task);
   if (auto t = r.table("seed", false)) read_seed(r.sub("seed", *t), task);
+  if (auto t = r.table("diversity", false)) read_diversity(r.sub("diversity", *t), task);
   return task;
 }
 

@@ -78,6 +78,14 @@ struct TaskSeed {
   double robustness = 0;          // weight of the margin tie-breaker (0 = penalty alone)
 };
 
+// How `diverse run` explores around M0 unless told otherwise.
+struct TaskDiversity {
+  // Initial CMA-ES step (normalized units). A task whose feasible region around M0 is
+  // thin (the backflip) needs a smaller one, or no sample of the first generations
+  // meets the task.
+  double sigma0 = 0.1;
+};
+
 struct Task {
   std::string file;         // the task file as given
   std::string name;
@@ -92,6 +100,7 @@ struct Task {
   int variations = 4;       // N
   std::string m0;           // resolved path of M0's parameters (need not exist yet)
   TaskSeed seed;
+  TaskDiversity diversity;
 
   const SceneObject* find_object(const std::string& name) const;
 };

@@ -92,6 +92,9 @@ TEST_F(TaskFileTest, ValidTextParses) {
   EXPECT_TRUE(t.constraints.landing);
   EXPECT_DOUBLE_EQ(t.constraints.landing_center, 1.0);
   EXPECT_DOUBLE_EQ(t.simulation.settle_time, 1.0);
+  EXPECT_DOUBLE_EQ(t.diversity.sigma0, 0.1);  // the default without a [diversity] table
+  EXPECT_DOUBLE_EQ(load_task(write(valid_text() + "[diversity]\nsigma0 = 0.03\n")).diversity.sigma0,
+                   0.03);
 }
 
 TEST_F(TaskFileTest, MissingField) {
@@ -120,6 +123,10 @@ TEST_F(TaskFileTest, OutOfRange) {
             ": constraints.landing.half_width: expected a number in [0.001, 10], got -1");
   EXPECT_EQ(error_of(replace(valid_text(), "metric = \"md\"", "metric = \"xyz\"")),
             ": metric: expected \"hf\", \"md\" or \"wja\", got \"xyz\"");
+  EXPECT_EQ(error_of(valid_text() + "[diversity]\nsigma0 = 2\n"),
+            ": diversity.sigma0: expected a number in [0.0001, 1], got 2");
+  const std::string unknown = error_of(valid_text() + "[diversity]\nlambda = 8\n");
+  EXPECT_EQ(unknown.rfind(": diversity.lambda: expected no such key", 0), 0u) << unknown;
 }
 
 TEST_F(TaskFileTest, ModelPathMissing) {
