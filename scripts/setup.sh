@@ -6,6 +6,7 @@ packages=(
   libmujoco-dev libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libosmesa6-dev ffmpeg fonts-dejavu-core
+  jq  # scripts/reproduce-table1.sh reads the runs' summary.json
   chromium
 )
 # The gallery page (web/) is built with node and npm and tested in Chromium; a node that is

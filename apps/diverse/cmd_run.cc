@@ -1,6 +1,7 @@
 // `diverse run [TASK]` and `diverse resume DIR`: diverse motions for a task.
 //
 //   diverse run backflip --n 4 --generations 500 --out runs/backflip
+//   diverse run backflip --vary shape --metric shape --out runs/backflip-shapes
 //   diverse resume runs/backflip
 //
 // See src/run/run.h for what a run directory holds.
@@ -23,6 +24,8 @@ struct RunArgs {
   std::string task = kDefaultTask;
   int n = 0;
   std::string metric;
+  std::string vary = "control";
+  double shape_weight = kDefaultShapeWeight;
   double k = 10.0;
   long long generations = 500;
   std::string strategy = "round-robin";
@@ -31,7 +34,7 @@ struct RunArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   int popsize = 16;
-  double sigma0 = 0.1;
+  double sigma0 = 0.0;  // 0 = the task's (diversity.sigma0, default 0.1)
   int window = 100;
   double epsilon = 1e-6;
   std::string out;
@@ -48,7 +51,18 @@ void install_run(CLI::App& app) {
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or path to a task file")
       ->capture_default_str();
   cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)");
-  cmd->add_option("--metric", args->metric, "Distance metric: hf, md or wja (default: the task's)");
+  cmd->add_option("--metric", args->metric,
+                  "Distance metric: hf, md or wja (motion), shape (body shape; needs --vary shape), "
+                  "or a motion metric plus the weighted shape distance: hf+shape, md+shape, "
+                  "wja+shape (default: the task's)");
+  cmd->add_option("--vary", args->vary,
+                  "What the variations may change: control (the controller's parameters) or "
+                  "shape (the controller's parameters and the body's 10 link-length scales)")
+      ->capture_default_str();
+  cmd->add_option("--shape-weight", args->shape_weight,
+                  "Weight of the shape distance (m) in a combined metric such as md+shape, in "
+                  "units of the motion metric per metre")
+      ->capture_default_str();
   cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")->capture_default_str();
   cmd->add_option("--generations", args->generations, "Generation limit")->capture_default_str();
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
@@ -66,8 +80,9 @@ void install_run(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--popsize", args->popsize, "CMA-ES samples per generation (lambda)")
       ->capture_default_str();
-  cmd->add_option("--sigma0", args->sigma0, "Initial CMA-ES step, in normalized units")
-      ->capture_default_str();
+  cmd->add_option("--sigma0", args->sigma0,
+                  "Initial CMA-ES step, in normalized units (default: the task's, 0.1 unless "
+                  "its [diversity] table says otherwise)");
   cmd->add_option("--window", args->window,
                   "Stop when D improves by less than --epsilon over this many generations (0 = off)")
       ->capture_default_str();
@@ -87,16 +102,20 @@ void install_run(CLI::App& app) {
       throw UserError("--generations: expected an integer >= 1, got " + std::to_string(a.generations));
     if (a.popsize < 2)
       throw UserError("--popsize: expected an integer >= 2, got " + std::to_string(a.popsize));
-    if (!(a.sigma0 > 0.0 && a.sigma0 <= 1.0))
+    if (a.sigma0 != 0.0 && !(a.sigma0 > 0.0 && a.sigma0 <= 1.0))
       throw UserError("--sigma0: expected a number in (0, 1], got " + std::to_string(a.sigma0));
     if (a.window < 0) throw UserError("--window: expected an integer >= 0");
     if (!(a.epsilon >= 0.0)) throw UserError("--epsilon: expected a number >= 0");
     if (!(a.checkpoint_seconds >= 0.0))
       throw UserError("--checkpoint-seconds: expected a number >= 0");
-    if (!a.metric.empty()) parse_metric(a.metric);
+    if (a.vary != "control" && a.vary != "shape")
+      throw UserError("--vary: expected control or shape, got '" + a.vary + "'");
+    if (!a.metric.empty()) parse_distance(a.metric, a.shape_weight);
     RunRequest request;
     request.task = a.task;
     request.metric = a.metric;
+    request.vary_shape = a.vary == "shape";
+    request.shape_weight = a.shape_weight;
     request.options.variations = a.n;
     request.options.k = a.k;
     request.options.max_generations = a.generations;

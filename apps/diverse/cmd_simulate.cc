@@ -1,7 +1,10 @@
 // `diverse simulate TASK [--params FILE] --out DIR`: simulates one parameter set of a
 // task (by default its input motion M0), prints every constraint term, and writes
-// DIR/motion.json with the exact-replay record (src/io/motion_record.h), DIR/model.xml as
-// MuJoCo saves it, and DIR/filmstrip.png with the character at the phase events.
+// DIR/motion.json with the exact-replay record (src/io/motion_record.h), DIR/model.xml
+// (as MuJoCo saves it, or the exact shaped text), and DIR/filmstrip.png with the
+// character at the phase events. A parameter file may also give the body shape as scales
+// "shape.NAME" (docs/shapes.md; a scale left out is 1); a motion file of a run with
+// varying shape is such a file.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -31,7 +34,7 @@ void run(const SimulateArgs& args) {
   const Task task = load_task(resolve_task_path(args.task));
   const TaskEvaluator ev(task);
   const std::string params_path = args.params.empty() ? task.m0 : args.params;
-  const ParameterSet params = ev.load_parameters(params_path);
+  const ParameterSet params = ev.load_shaped_parameters(params_path);
   const fs::path dir(args.out);
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -44,6 +47,12 @@ void run(const SimulateArgs& args) {
   const Evaluation e = write_motion(ev, params, info, dir / "motion.json", &record);
 
   std::printf("task %s, parameters %s\n", task.name.c_str(), params_path.c_str());
+  if (holds_shape(params)) {
+    std::printf("shape:");
+    for (const ParamSpec& spec : ev.shapes().specs())
+      std::printf(" %s %.4g", spec.name.c_str() + 6, params.get(spec.name));
+    std::printf("\n");
+  }
   for (const ConstraintTerm& t : e.report.terms) {
     std::printf("  %-12s violation %-10.4g penalty %.6g\n", t.name.c_str(), t.violation, t.penalty);
   }

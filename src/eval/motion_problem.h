@@ -3,9 +3,21 @@
 // A variation is the controller's normalized parameter vector; evaluating it runs one
 // rollout of the task (task/evaluate.h) and keeps what the distance metrics need: the
 // pose samples at phase-normalized times of the two airborne phases (10 each), turned
-// into metric poses with the whole-body centre of mass subtracted (metric/metric.h).
-// The objective's distance is the task's metric (or the one the user chose); the other
-// motion metrics can be computed on the same outcomes for reporting.
+// into metric poses with the whole-body centre of mass subtracted (metric/metric.h), and
+// the body's link lengths. The objective's distance is the task's metric (or the one the
+// user chose, possibly combined with the shape distance); the other metrics can be
+// computed on the same outcomes for reporting.
+//
+// Shape as a free parameter (paper section 8). With vary_shape a variation is the
+// controller's normalized parameters followed by the 10 normalized shape scales
+// (character/shape.h; every scale's range maps to [0, 1], so M0's body, scale 1, sits at
+// (1 - lower) / (upper - lower)). The paper optimized 36 control parameters beside the
+// 10 shape parameters; we keep all of the controller's (jump controller: 90), as for
+// motion-only runs. Each sample builds its own body: the task's scene at that shape is
+// compiled (about 2 ms, 5-10 % of a rollout), and the controller reads its segment
+// lengths from that body. A worker keeps the last shape it built and reuses it when the
+// next sample has the very same scales (M0, re-evaluated means): the scene is a pure
+// function of the scales, so results do not depend on what a worker ran before.
 //
 // Thread safety: one SimWorker per worker index, created up front; evaluate() with a
 // given worker index is never called concurrently (DiversityProblem's contract).
@@ -22,7 +34,9 @@ namespace diverse {
 
 // The outcome of one rollout.
 struct MotionOutcome : Outcome {
-  MotionFeatures features;   // pose samples for the metrics (empty without a flight)
+  MotionFeatures features;   // pose samples for the metrics (empty without a flight) and
+                             // the body's link lengths (always)
+  Eigen::VectorXd scales;    // the body's 10 shape scales (all 1 unless shape varies)
   bool fell = false;
   double landing_x = 0;      // m, mean foot x at rest (or at the end)
   double peak_com_z = 0;     // m
@@ -30,7 +44,12 @@ struct MotionOutcome : Outcome {
 
 class MotionProblem : public DiversityProblem {
  public:
-  // `evaluator` must outlive the problem. `reference` is M0's normalized parameters.
+  // `evaluator` must outlive the problem. `reference` is M0's normalized parameters
+  // (parameters().normalized() of M0: with vary_shape, followed by its shape's). A
+  // distance that uses the shape needs vary_shape (std::logic_error otherwise).
+  MotionProblem(const TaskEvaluator& evaluator, DistanceSpec distance, Eigen::VectorXd reference,
+                int workers, bool vary_shape = false);
+  // A motion-only problem under one motion metric.
   MotionProblem(const TaskEvaluator& evaluator, Metric metric, Eigen::VectorXd reference,
                 int workers);
 
@@ -39,25 +58,49 @@ class MotionProblem : public DiversityProblem {
   std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int worker) const override;
   double distance(const Outcome& a, const Outcome& b) const override;
 
-  // Distance between two outcomes under any motion metric (for the summary's matrices).
+  // Distance between two outcomes under any metric, shape included (for the summary's
+  // matrices), or under any spec.
   double distance(const Outcome& a, const Outcome& b, Metric metric) const;
+  double distance(const Outcome& a, const Outcome& b, const DistanceSpec& spec) const;
 
-  Metric metric() const { return metric_; }
+  // The names and ranges of a variation's parameters: the controller's and, with
+  // vary_shape, the shape scales after them (a template: values at the lower bounds).
+  const ParameterSet& parameters() const { return parameters_; }
+  // A normalized vector as named values.
+  ParameterSet named(const Eigen::VectorXd& x) const;
+  // Simulates x again on a worker of its own (thread-safe) with the options' recorder;
+  // `model_out` receives the model it ran on (the shaped scene's with vary_shape).
+  Evaluation simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
+                      std::shared_ptr<const SharedModel>* model_out = nullptr) const;
+
+  Metric metric() const { return distance_.metric; }
+  const DistanceSpec& distance_spec() const { return distance_; }
+  bool vary_shape() const { return vary_shape_; }
   const MetricLayout& layout() const { return layout_; }
   const TaskEvaluator& evaluator() const { return *evaluator_; }
   int workers() const { return static_cast<int>(workers_.size()); }
 
   // Metric layout of the planar human: hands and feet by link name, WJA weights from
-  // lee2002_joint_weight() on the joint names (root included).
+  // lee2002_joint_weight() on the joint names (root included), shape weights 1.
   static MetricLayout layout_for(const TaskEvaluator& evaluator);
 
  private:
+  // A worker's last shape and the simulation state on it.
+  struct ShapedWorker {
+    std::shared_ptr<const ShapedScene> scene;
+    std::unique_ptr<SimWorker> worker;
+  };
+
   const TaskEvaluator* evaluator_;
-  Metric metric_;
+  DistanceSpec distance_;
+  bool vary_shape_ = false;
   Eigen::VectorXd reference_;
+  ParameterSet parameters_;
   MetricLayout layout_;
   Eigen::VectorXd link_mass_;
+  Eigen::VectorXd base_scales_, base_link_lengths_;  // the task's body
   std::vector<std::unique_ptr<SimWorker>> workers_;
+  mutable std::vector<ShapedWorker> shaped_;  // one per worker index (vary_shape)
 };
 
 }  // namespace diverse

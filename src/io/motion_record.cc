@@ -44,6 +44,16 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
   j["task"] = evaluator.task().name;
   j["label"] = info.label;
   j["parameters"] = parameters.to_json();
+  if (holds_shape(parameters)) {
+    const ShapeSpace& shapes = evaluator.shapes();
+    const Eigen::VectorXd scales = shapes.scales_from(parameters);
+    const Eigen::VectorXd lengths = shapes.link_lengths(scales);
+    nlohmann::json named = nlohmann::json::object();
+    for (int p = 0; p < ShapeSpace::size(); ++p) named[shapes.specs()[static_cast<size_t>(p)].name] = scales[p];
+    j["shape"] = {{"scales", named},
+                  {"link_names", shapes.link_names()},
+                  {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())}};
+  }
 
   nlohmann::json terms = nlohmann::json::array();
   for (const ConstraintTerm& t : e.report.terms)
@@ -95,11 +105,15 @@ Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& para
                         const MotionRecordInfo& info, const fs::path& json_path,
                         StepRecorder* record_out) {
   StepRecorder record;
-  const auto worker = evaluator.make_worker();
   EvaluationOptions options;
   options.recorder = &record;
-  const Evaluation e = evaluator.evaluate(parameters.values(), *worker, options);
-  evaluator.model().save_xml(info.model_path.string());
+  std::shared_ptr<const SharedModel> model;
+  const Evaluation e = evaluator.evaluate_named(parameters, options, &model);
+  if (holds_shape(parameters)) {
+    write_file_atomic(info.model_path, model->xml());
+  } else {
+    model->save_xml(info.model_path.string());
+  }
   write_json_atomic(json_path, motion_record_json(evaluator, parameters, e, record, info, json_path));
   if (record_out) *record_out = std::move(record);
   return e;

@@ -6,14 +6,20 @@
 //   {
 //     "format": "diverse.motion", "version": 1,
 //     "task": "backflip", "label": "M1",
-//     "parameters": {"name": value, ...},          named controller parameters
+//     "parameters": {"name": value, ...},          named controller parameters (and the
+//                                                  shape scales "shape.*" of a shaped body)
+//     "shape": {"scales": {...}, "link_names": [...], "link_lengths": [...]}   shaped bodies
+//                                                  only: the 10 scales and the 17 link
+//                                                  lengths (m) of the shape distance
 //     "constraint": {"total": C, "fell": false, "terms": [{"name", "violation", "penalty"}]},
 //     "summary": {peak COM height, feet position at the end, rotation, ...},
 //     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never
 //     "pose_samples": {"link_names", "angle_names", "link_masses",
 //                      "samples": [{"phase", "phase_time", "time", "link_com", "angles"}]},
 //     "replay": {
-//       "model": "../model/m1.xml",   path of the MJCF saved by MuJoCo, relative to this file
+//       "model": "../model/m1.xml",   path of the MJCF, relative to this file: as MuJoCo
+//                                     saves it, or for a shaped body the exact shaped text
+//                                     (MuJoCo's writer keeps 6 digits: docs/shapes.md)
 //       "timestep": 0.002, "nq": 19, "nu": 16,
 //       "qpos0": [...], "qvel0": [...],            initial state
 //       "damped_dofs": [...],                      dofs whose dof_damping the controller sets
@@ -48,8 +54,10 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
                                   const MotionRecordInfo& info,
                                   const std::filesystem::path& json_path);
 
-// Simulates `parameters` with recording on, saves the model to info.model_path (as
-// MuJoCo writes it) and the motion file to json_path. Returns the evaluation.
+// Simulates `parameters` with recording on, saves the model to info.model_path and the
+// motion file to json_path. Returns the evaluation. Parameters holding shape scales
+// (holds_shape) run on that shape's scene, whose exact MJCF text is saved; otherwise
+// the task's model is saved as MuJoCo writes it.
 Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& parameters,
                         const MotionRecordInfo& info, const std::filesystem::path& json_path,
                         StepRecorder* record_out = nullptr);

@@ -21,6 +21,38 @@ Metric parse_metric(const std::string& name, const std::string& where) {
   throw_field_error(where, "", "unknown metric '" + name + "', expected one of hf, md, wja, shape");
 }
 
+DistanceSpec parse_distance(const std::string& name, double shape_weight, const std::string& where,
+                            const std::string& weight_where) {
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string suffix = "+shape";
+  if (lower.size() > suffix.size() && lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0) {
+    const std::string base = name.substr(0, name.size() - suffix.size());
+    DistanceSpec spec;
+    spec.metric = parse_metric(base, where);
+    if (spec.metric == Metric::kShape)
+      throw_field_error(where, "", "expected a motion metric (hf, md or wja) before \"+shape\", got '" + name + "'");
+    if (!(std::isfinite(shape_weight) && shape_weight > 0.0))
+      throw_field_error(weight_where, "", "expected a number > 0 (the weight of the shape distance in " +
+                                              name + "), got " + std::to_string(shape_weight));
+    spec.shape_weight = shape_weight;
+    return spec;
+  }
+  try {
+    return DistanceSpec{parse_metric(name, where), 0.0};
+  } catch (const UserError&) {
+    throw_field_error(where, "", "unknown metric '" + name +
+                                     "', expected one of hf, md, wja, shape, hf+shape, md+shape, wja+shape");
+  }
+}
+
+std::string to_string(const DistanceSpec& spec) {
+  std::string name = to_string(spec.metric);
+  if (spec.combined()) name += "+shape";
+  return name;
+}
+
 const char* to_string(Metric metric) {
   switch (metric) {
     case Metric::kHandsFeet: return "hf";

@@ -99,12 +99,13 @@ int add_model(nlohmann::json& models, const mjModel* model) {
   return static_cast<int>(models.size()) - 1;
 }
 
-// Named parameters from a path or motion file. A value written from a normalized
+// Named parameters from a path or motion file, as `like` names them (the controller's,
+// and the shape scales of a run whose shape varied). A value written from a normalized
 // coordinate of exactly 0 or 1 can miss its bound by a rounding error (lower + 1 * (upper -
 // lower) != upper); such values are put back on the bound before the strict check.
-ParameterSet named_parameters(const TaskEvaluator& evaluator, nlohmann::json values,
+ParameterSet named_parameters(const ParameterSet& like, nlohmann::json values,
                               const std::string& origin) {
-  ParameterSet set = evaluator.parameters();
+  ParameterSet set = like;
   if (values.is_object()) {
     for (const ParamSpec& spec : set.specs()) {
       auto it = values.find(spec.name);
@@ -119,11 +120,11 @@ ParameterSet named_parameters(const TaskEvaluator& evaluator, nlohmann::json val
   return set;
 }
 
-ParameterSet motion_parameters(const TaskEvaluator& evaluator, const fs::path& motion_file) {
+ParameterSet motion_parameters(const ParameterSet& like, const fs::path& motion_file) {
   const nlohmann::json motion = read_json(motion_file);
   if (!motion.is_object() || !motion.contains("parameters"))
     throw_field_error(motion_file.string(), "parameters", "the motion's named controller parameters");
-  return named_parameters(evaluator, motion["parameters"], motion_file.string());
+  return named_parameters(like, motion["parameters"], motion_file.string());
 }
 
 // One point of a variation's path: its parameters and where it comes from.
@@ -135,7 +136,7 @@ struct PathPoint {
 };
 
 std::vector<PathPoint> read_path(const RunView& run, std::size_t variation,
-                                 const TaskEvaluator& evaluator) {
+                                 const ParameterSet& like) {
   const fs::path file = run.dir / "paths" / (stem('m', variation) + ".json");
   if (!fs::exists(file))
     throw UserError(file.string() + ": missing; the run directory is incomplete (`diverse resume " +
@@ -149,10 +150,10 @@ std::vector<PathPoint> read_path(const RunView& run, std::size_t variation,
     const std::string field = "points[" + std::to_string(k) + "]";
     if (!p.is_object() || !p.contains("parameters"))
       throw_field_error(file.string(), field, "an object with \"parameters\"");
-    const ParameterSet set = named_parameters(evaluator, p["parameters"], file.string() + ": " + field);
+    const ParameterSet set = named_parameters(like, p["parameters"], file.string() + ": " + field);
     points.push_back({set.normalized(), p.value("generation", -1), p.value("step", -1), false});
   }
-  const ParameterSet result = motion_parameters(evaluator, run.motions[variation].file);
+  const ParameterSet result = motion_parameters(like, run.motions[variation].file);
   points.push_back({result.normalized(), -1, -1, true});
   return points;
 }
@@ -169,11 +170,18 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   if (read_file(task_file) != run.run.value("task_text", std::string()))
     throw UserError(run_file.string() + ": task_file: " + task_file + " changed since the run;" + what);
   const TaskEvaluator evaluator(load_task(task_file));
-  const Metric metric = parse_metric(run.metric, (run.dir / "summary.json").string() + ": metric");
-  const ParameterSet m0 = motion_parameters(evaluator, run.motions[0].file);
+  const DistanceSpec distance =
+      parse_distance(run.metric, run.run.value("shape_weight", kDefaultShapeWeight),
+                     (run.dir / "summary.json").string() + ": metric", run_file.string() + ": shape_weight");
+  // A run whose shape varied names its shape scales after the controller's parameters.
+  const nlohmann::json vary = run.run.value("vary", nlohmann::json::array());
+  const bool vary_shape = std::find(vary.begin(), vary.end(), "shape") != vary.end();
+  ParameterSet like = evaluator.parameters();
+  if (vary_shape) like = evaluator.with_shape(like, ShapeSpace::identity());
+  const ParameterSet m0 = motion_parameters(like, run.motions[0].file);
 
   const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
-  const MotionProblem problem(evaluator, metric, m0.normalized(), threads);
+  const MotionProblem problem(evaluator, distance, m0.normalized(), threads, vary_shape);
   ThreadPool pool(threads);
 
   // Which points of each path are simulated to measure distances: all, or evenly spaced.
@@ -186,7 +194,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   };
   std::vector<Job> jobs;
   for (std::size_t v = 1; v <= variations; ++v) {
-    paths[v] = read_path(run, v, evaluator);
+    paths[v] = read_path(run, v, like);
     const int n = static_cast<int>(paths[v].size());
     const int want = std::max(2, options.max_path_candidates);
     for (int k = 0; k < std::min(n, want); ++k) {
@@ -210,7 +218,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
     double distance = 0;
     const Outcome* outcome = nullptr;
     nlohmann::json frames;
-    int model = 0;
+    std::shared_ptr<const SharedModel> model;  // what a point that is not the result ran on
     double duration = 0;
   };
   std::vector<Pick> picks;
@@ -232,15 +240,13 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
     const std::vector<int> chosen = pick_path_points(distances, options.path_fractions);
     for (std::size_t f = 0; f < chosen.size(); ++f) {
       const auto c = static_cast<std::size_t>(chosen[f]);
-      picks.push_back({v, candidates[v][c], options.path_fractions[f], distances[c], outs[c], {}, 0, 0});
+      picks.push_back({v, candidates[v][c], options.path_fractions[f], distances[c], outs[c], {}, nullptr, 0});
     }
   }
 
-  // Simulate the picked points with recording on; a variation's result is its recorded
-  // motion, exactly as the run left it.
-  std::vector<std::unique_ptr<SimWorker>> workers;
-  for (int w = 0; w < pool.size(); ++w) workers.push_back(evaluator.make_worker());
-  pool.parallel_for(picks.size(), [&](std::size_t i, int worker) {
+  // Simulate the picked points with recording on, each on its own body; a variation's
+  // result is its recorded motion, exactly as the run left it.
+  pool.parallel_for(picks.size(), [&](std::size_t i, int) {
     Pick& pick = picks[i];
     const PathPoint& point = paths[pick.variation][static_cast<std::size_t>(pick.point)];
     if (point.result) {
@@ -249,17 +255,14 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
       pick.duration = m.duration();
       return;
     }
-    ParameterSet set = evaluator.parameters();
-    set.set_normalized(point.x);
     RunMotion sim;
     EvaluationOptions eval;
     eval.recorder = &sim.record;
-    evaluator.evaluate(set.values(), *workers[static_cast<std::size_t>(worker)], eval);
-    pick.frames = body_frames_json(evaluator.model().get(), sim.sample(options.fps));
+    problem.simulate(point.x, eval, &pick.model);
+    pick.frames = body_frames_json(pick.model->get(), sim.sample(options.fps));
     pick.duration = sim.duration();
   });
 
-  const int task_model = add_model(models, evaluator.model().get());
   nlohmann::json out = nlohmann::json::array();
   out.push_back(nullptr);  // M0 has no path
   for (std::size_t v = 1; v <= variations; ++v) {
@@ -280,7 +283,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
            {"constraint", std::isfinite(c) ? nlohmann::json(c) : nlohmann::json(nullptr)},
            {"failed", failed},
            {"feasible", c == 0.0 && !failed},
-           {"model", point.result ? add_model(models, m.model->get()) : task_model},
+           {"model", add_model(models, point.result ? m.model->get() : pick.model->get())},
            {"duration", pick.duration},
            {"frames", pick.frames}});
     }

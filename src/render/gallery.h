@@ -19,9 +19,10 @@
 //     variation i (paths/m<i>.json) to the variation's result (motions/m<i>.json). Paper
 //     figure 6a parameterizes it by the metric distance of each point's motion from M0, so
 //     the path's points are simulated when the gallery is made (TaskEvaluator on the run's
-//     task file; at most `max_path_candidates` of them, evenly spaced, to measure
-//     distances), and the point nearest to each fraction of the result's distance is
-//     simulated again with recording on. Points that miss the task (C > 0) are marked.
+//     task file, each point on its own body when the run varied the shape; at most
+//     `max_path_candidates` of them, evenly spaced, to measure distances), and the point
+//     nearest to each fraction of the result's distance is simulated again with
+//     recording on. Points that miss the task (C > 0) are marked.
 #pragma once
 
 #include <mujoco/mujoco.h>

@@ -25,12 +25,6 @@ nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
   return rows;
 }
 
-ParameterSet named(const ParameterSet& like, const Eigen::VectorXd& x) {
-  ParameterSet p = like;
-  p.set_normalized(x);
-  return p;
-}
-
 // (Built with append: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string.)
 std::string numbered(char prefix, std::size_t i) {
   std::string s(1, prefix);
@@ -59,26 +53,32 @@ void write_run_outputs(const RunOutputs& o) {
     for (const PathPoint& point : paths[v])
       points.push_back({{"generation", point.generation},
                         {"step", point.step},
-                        {"parameters", named(o.m0, point.x).to_json()}});
+                        {"parameters", o.problem.named(point.x).to_json()}});
     write_json_atomic(o.dir / "paths" / (stem(v) + ".json"),
-                      {{"variation", v}, {"metric", to_string(o.problem.metric())}, {"points", points}});
+                      {{"variation", v}, {"metric", to_string(o.problem.distance_spec())}, {"points", points}});
   }
 
-  // Every motion metric on the final outcomes.
+  // Every metric on the final outcomes: the motion metrics, the shape metric, and the
+  // objective's combination if it is one.
+  const DistanceSpec objective = o.problem.distance_spec();
   nlohmann::json distances;
-  distances["objective"] = to_string(o.problem.metric());
-  for (Metric metric : kMotionMetrics) {
+  distances["objective"] = to_string(objective);
+  std::vector<DistanceSpec> specs;
+  for (Metric metric : kMotionMetrics) specs.push_back({metric, 0.0});
+  specs.push_back({Metric::kShape, 0.0});
+  if (objective.combined()) specs.push_back(objective);
+  for (const DistanceSpec& spec : specs) {
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(count),
                                               static_cast<Eigen::Index>(count));
     for (std::size_t i = 0; i < count; ++i)
       for (std::size_t j = i + 1; j < count; ++j) {
         const auto& a = *result.outcomes[i];
         const auto& b = *result.outcomes[j];
-        const double v = (is_failure(a) || is_failure(b)) ? 0.0 : o.problem.distance(a, b, metric);
+        const double v = (is_failure(a) || is_failure(b)) ? 0.0 : o.problem.distance(a, b, spec);
         d(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v;
         d(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = v;
       }
-    distances[to_string(metric)] = matrix_json(d);
+    distances[to_string(spec)] = matrix_json(d);
   }
 
   // The scale of "different": the mean distance between M0 and M0 nudged by 0.01 (in
@@ -104,15 +104,20 @@ void write_run_outputs(const RunOutputs& o) {
   std::vector<StepRecorder> records(count);
   o.pool.parallel_for(count, [&](std::size_t i, int) {
     const MotionRecordInfo info{label(i), o.dir / "model" / (stem(i) + ".xml")};
-    evaluations[i] = write_motion(o.evaluator, named(o.m0, result.parameters[i]), info,
+    evaluations[i] = write_motion(o.evaluator, o.problem.named(result.parameters[i]), info,
                                   o.dir / "motions" / (stem(i) + ".json"),
                                   &records[i]);
   });
 
+  const ShapeSpace& shapes = o.evaluator.shapes();
   nlohmann::json motions = nlohmann::json::array();
   for (std::size_t i = 0; i < count; ++i) {
     const auto& outcome = static_cast<const MotionOutcome&>(*result.outcomes[i]);
     const auto idx = static_cast<Eigen::Index>(i);
+    nlohmann::json scales = nlohmann::json::object();
+    for (int p = 0; p < ShapeSpace::size(); ++p)
+      scales[shapes.specs()[static_cast<std::size_t>(p)].name] = outcome.scales[p];
+    const Eigen::VectorXd& lengths = outcome.features.link_lengths;
     motions.push_back({{"index", i},
                        {"label", label(i)},
                        {"constraint", result.score.constraint[idx]},
@@ -121,6 +126,8 @@ void write_run_outputs(const RunOutputs& o) {
                        {"failed", outcome.failed},
                        {"landing_x", outcome.landing_x},
                        {"peak_com_z", outcome.peak_com_z},
+                       {"shape_scales", scales},
+                       {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())},
                        {"file", "motions/" + stem(i) + ".json"}});
   }
 
@@ -130,7 +137,8 @@ void write_run_outputs(const RunOutputs& o) {
       {"version", 1},
       {"task", ev.task().name},
       {"task_file", ev.task().file},
-      {"metric", to_string(o.problem.metric())},
+      {"metric", to_string(objective)},
+      {"vary", o.problem.vary_shape() ? nlohmann::json{"control", "shape"} : nlohmann::json{"control"}},
       {"N", options.variations},
       {"K", options.k},
       {"strategy", to_string(options.strategy)},
@@ -143,6 +151,7 @@ void write_run_outputs(const RunOutputs& o) {
       {"stop", to_string(result.stop)},
       {"D", result.score.D},
       {"all_satisfied", (result.score.constraint.array() == 0.0).all()},
+      {"link_names", shapes.link_names()},
       {"motions", motions},
       {"distances", distances},
       {"nudged_m0_distance", nudge_mean},
@@ -151,6 +160,7 @@ void write_run_outputs(const RunOutputs& o) {
         {"threads", o.pool.size()},
         {"evaluations_per_second",
          o.wall_seconds > 0 ? static_cast<double>(result.evaluations) / o.wall_seconds : 0.0}}}};
+  if (objective.combined()) summary["shape_weight"] = objective.shape_weight;
   write_json_atomic(o.dir / "summary.json", summary);
 
   // The film strip is drawn from the files just written, as `diverse render` draws it.

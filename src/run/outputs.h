@@ -18,15 +18,18 @@ namespace diverse {
 struct RunOutputs {
   std::filesystem::path dir;
   const TaskEvaluator& evaluator;
-  const MotionProblem& problem;
-  const ParameterSet& m0;  // names and ranges of the parameters
+  const MotionProblem& problem;  // names the parameters (MotionProblem::named)
   const DiversityOptimizer& optimizer;
   ThreadPool& pool;
   double wall_seconds = 0;  // total, over all sessions of the run
   bool render = true;
 };
 
+// summary.json: the run's settings and result ("metric" the objective's distance, "vary"
+// the parameter groups), per motion its C, dmin, shape scales and link lengths (m,
+// "link_names" order), and "distances": the pairwise matrices over M0..MN of every motion
+// metric (hf, md, wja) and of the shape metric (all zero when the shape did not vary),
+// plus the objective's own matrix when it combines a motion metric with the shape.
 void write_run_outputs(const RunOutputs& outputs);
-
 
 }  // namespace diverse

@@ -26,41 +26,64 @@ constexpr const char* kCheckpointFormat = "diverse.run_checkpoint";
 // Everything a run needs that is rebuilt from run.json on resume.
 struct RunSetup {
   std::unique_ptr<TaskEvaluator> evaluator;
-  Metric metric = Metric::kMassDistance;
+  DistanceSpec distance;
+  bool vary_shape = false;
   DiversityOptions options;
-  ParameterSet m0;
+  ParameterSet m0;  // M0's parameters, with its shape (scale 1) when shape varies
   std::string task_path;
   std::string task_text;
 };
 
 RunSetup make_setup(const std::string& task_path, const std::string& metric_name,
-                    const DiversityOptions& options) {
+                    double shape_weight, bool vary_shape, const DiversityOptions& options) {
   RunSetup setup;
   setup.task_path = fs::absolute(task_path).lexically_normal().string();
   setup.task_text = read_file(setup.task_path);
   Task task = load_task(setup.task_path);
   const std::string metric = metric_name.empty() ? task.metric : metric_name;
-  setup.metric = parse_metric(metric, metric_name.empty() ? task.file + ": metric" : "--metric");
-  if (setup.metric == Metric::kShape)
-    throw UserError("--metric: the shape metric needs shape parameters (--vary shape)");
+  setup.distance =
+      parse_distance(metric, shape_weight, metric_name.empty() ? task.file + ": metric" : "--metric");
+  setup.vary_shape = vary_shape;
+  if (setup.distance.uses_shape() && !vary_shape)
+    throw UserError("--metric: the " + to_string(setup.distance) +
+                    " metric needs the shape parameters (--vary shape)");
   setup.options = options;
   if (setup.options.variations == 0) setup.options.variations = task.variations;
+  if (setup.options.sigma0 == 0.0) setup.options.sigma0 = task.diversity.sigma0;
   if (!fs::exists(task.m0))
     throw UserError(task.file + ": m0: " + task.m0 +
                     " does not exist (create it with `diverse seed-motion " + task.name + "`)");
   setup.evaluator = std::make_unique<TaskEvaluator>(std::move(task));
   setup.m0 = setup.evaluator->load_parameters(setup.evaluator->task().m0);
+  if (vary_shape) setup.m0 = setup.evaluator->with_shape(setup.m0, ShapeSpace::identity());
   return setup;
 }
 
+// The parameter groups a run varies, as run.json and checkpoint.json record them.
+nlohmann::json vary_json(bool vary_shape) {
+  return vary_shape ? nlohmann::json{"control", "shape"} : nlohmann::json{"control"};
+}
+
 nlohmann::json run_json(const RunSetup& setup) {
-  return {{"format", kRunFormat},
-          {"version", kRunVersion},
-          {"diverse_version", DIVERSE_VERSION},
-          {"task_file", setup.task_path},
-          {"task_text", setup.task_text},
-          {"metric", to_string(setup.metric)},
-          {"options", to_json(setup.options)}};
+  nlohmann::json j = {{"format", kRunFormat},
+                      {"version", kRunVersion},
+                      {"diverse_version", DIVERSE_VERSION},
+                      {"task_file", setup.task_path},
+                      {"task_text", setup.task_text},
+                      {"metric", to_string(setup.distance)},
+                      {"vary", vary_json(setup.vary_shape)},
+                      {"options", to_json(setup.options)}};
+  if (setup.distance.combined()) j["shape_weight"] = setup.distance.shape_weight;
+  return j;
+}
+
+// "vary" of run.json (absent in runs from before shapes could vary: control only).
+bool read_vary_shape(const nlohmann::json& run, const std::string& where) {
+  if (!run.contains("vary")) return false;
+  const nlohmann::json& vary = run["vary"];
+  if (vary == vary_json(false)) return false;
+  if (vary == vary_json(true)) return true;
+  throw_field_error(where, "vary", "expected [\"control\"] or [\"control\", \"shape\"]");
 }
 
 int resolve_threads(int threads) {
@@ -81,6 +104,7 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   auto write_checkpoint = [&] {
     write_json_atomic(dir / "checkpoint.json", {{"format", kCheckpointFormat},
                                                 {"wall_seconds", elapsed()},
+                                                {"vary", vary_json(setup.vary_shape)},
                                                 {"optimizer", optimizer.checkpoint()}});
   };
 
@@ -109,7 +133,7 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
                      ") after " + std::to_string(optimizer.generation()) + " generations, " +
                      std::to_string(optimizer.evaluations()) + " evaluations");
 
-  RunOutputs outputs{dir, *setup.evaluator, problem, setup.m0, optimizer, pool};
+  RunOutputs outputs{dir, *setup.evaluator, problem, optimizer, pool};
   outputs.wall_seconds = elapsed();
   outputs.render = render;
   write_run_outputs(outputs);
@@ -131,7 +155,8 @@ nlohmann::json without_timing(nlohmann::json summary) {
 
 void start_run(const RunRequest& request) {
   const int threads = resolve_threads(request.threads);
-  RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.options);
+  RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.shape_weight,
+                              request.vary_shape, request.options);
   try {
     validate(setup.options);  // after the task's N has filled in variations = 0
   } catch (const std::invalid_argument& e) {
@@ -151,7 +176,8 @@ void start_run(const RunRequest& request) {
   write_json_atomic(request.out / "run.json", run_json(setup));
 
   ThreadPool pool(threads);
-  const MotionProblem problem(*setup.evaluator, setup.metric, setup.m0.normalized(), pool.size());
+  const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
+                              setup.vary_shape);
   DiversityOptimizer optimizer(problem, setup.options, pool);
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
         request.quiet, request.render);
@@ -176,6 +202,7 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
     if (read_file(task_file) != task_text)
       throw UserError(task_file + ": changed since the run started; a resumed run must use the same task");
     setup = make_setup(task_file, run.at("metric").get<std::string>(),
+                       run.value("shape_weight", kDefaultShapeWeight), read_vary_shape(run, where),
                        diversity_options_from_json(run.at("options")));
   } catch (const nlohmann::json::exception& e) {
     throw UserError(where + ": expected the settings `diverse run` writes (" + e.what() + ")");
@@ -188,9 +215,13 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   if (!checkpoint.is_object() || checkpoint.value("format", "") != kCheckpointFormat ||
       !checkpoint.contains("optimizer"))
     throw UserError(cwhere + ": format: expected a checkpoint written by `diverse run`");
+  if (checkpoint.contains("vary") && checkpoint["vary"] != vary_json(setup.vary_shape))
+    throw UserError(cwhere + ": vary: " + checkpoint["vary"].dump() + " does not match run.json's " +
+                    vary_json(setup.vary_shape).dump());
 
   ThreadPool pool(threads);
-  const MotionProblem problem(*setup.evaluator, setup.metric, setup.m0.normalized(), pool.size());
+  const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
+                              setup.vary_shape);
   std::unique_ptr<DiversityOptimizer> optimizer;
   try {
     optimizer = std::make_unique<DiversityOptimizer>(

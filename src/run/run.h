@@ -2,17 +2,21 @@
 //
 // `diverse run TASK --out DIR` and `diverse resume DIR` both end here. A run directory:
 //
-//   run.json            settings: task file (absolute path and its text), metric, the
-//                       optimizer's options, version
+//   run.json            settings: task file (absolute path and its text), metric (and the
+//                       shape weight of a combined one), the parameter groups that vary
+//                       ("vary": ["control"] or ["control", "shape"]), the optimizer's
+//                       options, version
 //   checkpoint.json     the optimizer's complete state at a generation boundary, written
 //                       atomically (temp + rename) every few seconds and at the end
 //   log.jsonl           one JSON record per CMA step (generation, variation, D, C, dmin,
 //                       evaluations)
-//   paths/m<i>.json     variation i's optimization path: its mean after each of its steps,
-//                       as named controller parameters
-//   summary.json        the result (see write_summary), written when the run ends
+//   paths/m<i>.json     variation i's optimization path: where it stood after each of its
+//                       steps, as named controller parameters (and shape scales)
+//   summary.json        the result (run/outputs.h), written when the run ends
 //   motions/m<i>.json   i = 0..N: parameters, phase boundaries, pose samples and the
 //                       exact-replay record; model/m<i>.xml is the model it replays on
+//                       (with varying shape, each motion's own body: the exact shaped
+//                       MJCF text)
 //   filmstrip.png       M0..MN at the same phase events, one row each
 //
 // Results never depend on the thread count or on interruptions: a run killed at any
@@ -30,8 +34,10 @@ namespace diverse {
 
 struct RunRequest {
   std::string task;                 // task name or path (resolve_task_path)
-  std::string metric;               // "" = the task's metric
-  DiversityOptions options;         // variations = 0 means the task's N
+  std::string metric;               // "" = the task's metric; "shape", "md+shape", ...
+  double shape_weight = 10.0;       // weight of the shape distance in "<metric>+shape"
+  bool vary_shape = false;          // the 10 shape scales are free parameters too
+  DiversityOptions options;         // variations = 0 means the task's N, sigma0 = 0 its sigma0
   std::filesystem::path out;        // run directory
   int threads = 0;                  // 0 = one per core
   bool force = false;               // replace an existing run in `out`

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -146,7 +147,11 @@ ParameterSet TaskEvaluator::parameters() const {
   return ParameterSet(specs, values);
 }
 
-ParameterSet TaskEvaluator::load_parameters(const std::string& path) const {
+namespace {
+
+// The named values of a parameter file: {"parameters": {...}} (a motion or M0 file) or
+// the object itself.
+nlohmann::json read_parameter_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw UserError(path + ": cannot read the parameter file");
   nlohmann::json j;
@@ -155,12 +160,15 @@ ParameterSet TaskEvaluator::load_parameters(const std::string& path) const {
   } catch (const nlohmann::json::parse_error& e) {
     throw UserError(path + ": expected valid JSON (" + std::string(e.what()) + ")");
   }
+  if (j.is_object() && j.contains("parameters")) return j["parameters"];
+  return j;
+}
+
+}  // namespace
+
+ParameterSet TaskEvaluator::load_parameters(const std::string& path) const {
   ParameterSet p = parameters();
-  if (j.is_object() && j.contains("parameters")) {
-    p.set_from_json(j["parameters"], path);
-  } else {
-    p.set_from_json(j, path);
-  }
+  p.set_from_json(read_parameter_file(path), path);
   return p;
 }
 
@@ -193,14 +201,19 @@ Evaluation TaskEvaluator::evaluate(const std::vector<double>& values, SimWorker&
   if (&worker.shared() != model_.get()) {
     throw std::logic_error("TaskEvaluator::evaluate: worker belongs to another model");
   }
+  return evaluate_on(values, *body_, worker, options);
+}
+
+Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const PlanarHuman& body,
+                                      SimWorker& worker, const EvaluationOptions& options) const {
   Evaluation e;
   worker.reset();
   mjModel* m = worker.model();
-  JumpController controller(*body_, task_.controller_config);
+  JumpController controller(body, task_.controller_config);
   controller.set_parameters(values);
   e.flight_time.reserve(1024);
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
-  JumpHooks hooks(task_, *body_, controller, obstacle_geom_, e);
+  JumpHooks hooks(task_, body, controller, obstacle_geom_, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
   e.stats = run_rollout(worker, hooks, max_steps, controller.damped_dofs(), options.recorder);
   e.phases = controller.phase_times();
@@ -223,6 +236,120 @@ Evaluation TaskEvaluator::evaluate(const std::vector<double>& values, SimWorker&
     }
   }
   return e;
+}
+
+bool holds_shape(const ParameterSet& params) {
+  for (const ParamSpec& spec : params.specs())
+    if (spec.name.rfind("shape.", 0) == 0) return true;
+  return false;
+}
+
+const ShapeSpace& TaskEvaluator::shapes() const {
+  std::call_once(shapes_->once, [this] {
+    shapes_->space = std::make_unique<ShapeSpace>(model_->xml(), task_.character);
+  });
+  return *shapes_->space;
+}
+
+ParameterSet TaskEvaluator::with_shape(const ParameterSet& control, const Eigen::VectorXd& scales) const {
+  const ShapeSpace& space = shapes();
+  if (scales.size() != ShapeSpace::size()) throw std::logic_error("with_shape: expected 10 scales");
+  std::vector<ParamSpec> specs = control.specs();
+  std::vector<double> values = control.values();
+  for (int p = 0; p < ShapeSpace::size(); ++p) {
+    specs.push_back(space.specs()[static_cast<size_t>(p)]);
+    values.push_back(scales[p]);
+  }
+  return ParameterSet(std::move(specs), std::move(values));
+}
+
+std::vector<double> TaskEvaluator::control_values(const ParameterSet& params) const {
+  const auto& specs = JumpController::parameter_specs();
+  std::vector<double> values;
+  values.reserve(specs.size());
+  for (const ParamSpec& s : specs) values.push_back(params.get(s.name));
+  return values;
+}
+
+ParameterSet TaskEvaluator::load_shaped_parameters(const std::string& path) const {
+  const nlohmann::json all = read_parameter_file(path);
+  ParameterSet p = parameters();
+  if (!all.is_object()) {
+    p.set_from_json(all, path);  // reports the file's shape
+    return p;
+  }
+  // Shape scales apart: they are checked against the shape's own ranges.
+  nlohmann::json control = nlohmann::json::object(), shape = nlohmann::json::object();
+  for (const auto& [name, value] : all.items()) (name.rfind("shape.", 0) == 0 ? shape : control)[name] = value;
+  p.set_from_json(control, path);
+  if (shape.empty()) return p;
+  const ShapeSpace& space = shapes();
+  Eigen::VectorXd scales = ShapeSpace::identity();
+  for (const auto& [name, value] : shape.items()) {
+    int index = -1;
+    for (int k = 0; k < ShapeSpace::size(); ++k)
+      if (space.specs()[static_cast<size_t>(k)].name == name) index = k;
+    if (index < 0) throw_field_error(path, name, "expected a known shape parameter (shape.pelvis, ..., shape.hand)");
+    const ParamSpec& s = space.specs()[static_cast<size_t>(index)];
+    if (!value.is_number()) {
+      std::ostringstream range;
+      range << "expected a scale in [" << s.lower << ", " << s.upper << "], got " << value.dump();
+      throw_field_error(path, name, range.str());
+    }
+    scales[index] = value.get<double>();
+  }
+  space.validate(scales, path);
+  return with_shape(p, scales);
+}
+
+std::shared_ptr<const ShapedScene> TaskEvaluator::shaped_scene(const Eigen::VectorXd& scales,
+                                                               const std::string& origin) const {
+  const ShapeSpace& space = shapes();
+  auto scene = std::make_shared<ShapedScene>();
+  scene->scales = scales;
+  scene->model = space.compile(scales, origin);  // validates
+  scene->link_lengths = space.link_lengths(scales);
+  scene->standing = space.standing(scales);
+  scene->body = std::make_shared<const PlanarHuman>(scene->model->get(), origin);
+  return scene;
+}
+
+Evaluation TaskEvaluator::evaluate(const std::vector<double>& values, const ShapedScene& scene,
+                                   SimWorker& worker, const EvaluationOptions& options) const {
+  if (&worker.shared() != scene.model.get()) {
+    throw std::logic_error("TaskEvaluator::evaluate: worker does not run the shaped scene");
+  }
+  Evaluation e = evaluate_on(values, *scene.body, worker, options);
+  if (scene.below_floor()) {
+    // The contact is seen at the first step already; stating it here keeps the outcome
+    // (the earliest fall, with its reason) independent of how the contact plays out.
+    std::ostringstream why;
+    why.precision(3);
+    why << "the shape starts with a hand or arm " << scene.standing.feet_z - scene.standing.lowest_other_z
+        << " m below the floor";
+    e.summary.fell = true;
+    e.summary.fall_reason = why.str();
+    e.summary.fall_progress = 0;
+    e.poses.clear();
+    e.report = evaluate_constraints(task_, e.summary);
+    e.constraint = e.report.total;
+    e.fell = true;
+  }
+  return e;
+}
+
+Evaluation TaskEvaluator::evaluate_named(const ParameterSet& params, const EvaluationOptions& options,
+                                         std::shared_ptr<const SharedModel>* model_out) const {
+  const std::vector<double> control = control_values(params);
+  if (!holds_shape(params)) {
+    const auto worker = make_worker();
+    if (model_out) *model_out = model_;
+    return evaluate(control, *worker, options);
+  }
+  const auto scene = shaped_scene(shapes().scales_from(params));
+  SimWorker worker(scene->model);
+  if (model_out) *model_out = scene->model;
+  return evaluate(control, *scene, worker, options);
 }
 
 std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int phase,

@@ -18,10 +18,12 @@
 
 #include <Eigen/Dense>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "character/planar_human.h"
+#include "character/shape.h"
 #include "control/jump_controller.h"
 #include "control/parameters.h"
 #include "physics/model.h"
@@ -60,6 +62,21 @@ struct Evaluation {
   bool has_flight() const { return phases.takeoff() >= 0 && phases.peak() >= 0 && phases.landing() >= 0; }
 };
 
+// The task's scene with the character at one body shape (character/shape.h). Immutable:
+// threads share it, each with its own SimWorker on `model`.
+struct ShapedScene {
+  Eigen::VectorXd scales;                    // the 10 scales, ShapeSpace order
+  Eigen::VectorXd link_lengths;              // m, one per link, PlanarHuman::links order
+  StandingShape standing;                    // start height and ground clearance
+  std::shared_ptr<const SharedModel> model;  // the shaped scene; model->xml() is its exact text
+  std::shared_ptr<const PlanarHuman> body;   // the character map of `model`
+  // A hand or arm starts below the lowest point of the feet: the body cannot stand.
+  bool below_floor() const { return standing.lowest_other_z < standing.feet_z; }
+};
+
+// True when a parameter set holds shape scales ("shape.*" names, ShapeSpace::specs()).
+bool holds_shape(const ParameterSet& params);
+
 class TaskEvaluator {
  public:
   explicit TaskEvaluator(Task task);
@@ -89,6 +106,37 @@ class TaskEvaluator {
   std::vector<PoseSample> sample_poses(const Evaluation& e, int phase,
                                        const std::vector<double>& taus, SimWorker& worker) const;
 
+  // Body shape (character/shape.h, docs/shapes.md). Masses, joint ranges and torque
+  // limits never change with the shape; link lengths, inertias and the start height do.
+  //
+  // The shape space of the task's scene, parsed on first use (thread-safe). Throws
+  // UserError if the character is not the shape-parameterized planar human.
+  const ShapeSpace& shapes() const;
+  // `control` (the controller's parameters) followed by the 10 shape scales.
+  ParameterSet with_shape(const ParameterSet& control, const Eigen::VectorXd& scales) const;
+  // The controller's values (parameters() order) of a set that may also hold shape scales.
+  std::vector<double> control_values(const ParameterSet& params) const;
+  // Like load_parameters(), but the file may also hold shape scales "shape.NAME": then the
+  // result is with_shape() of them, a scale the file leaves out being 1 (as written). A
+  // scale out of its range is a UserError "PATH: shape.NAME: expected a scale in [LOWER,
+  // UPPER], got V"; an unknown "shape.*" name or a non-number one names it likewise.
+  ParameterSet load_shaped_parameters(const std::string& path) const;
+  // The scene of one shape, validated (UserError "ORIGIN: shape.NAME: expected a scale in
+  // ...") and compiled. Thread-safe; about 2 ms (the MuJoCo compile).
+  std::shared_ptr<const ShapedScene> shaped_scene(const Eigen::VectorXd& scales,
+                                                  const std::string& origin = "shape") const;
+  // evaluate() on a body of another shape; `worker` must run scene.model. A shape whose
+  // hand or arm starts below the floor (scene.below_floor()) cannot stand: it is simulated
+  // as usual (its first step sees the contact) and always counts as a fall at the very
+  // start, with that reason, so its constraint value is the largest fall penalty.
+  Evaluation evaluate(const std::vector<double>& values, const ShapedScene& scene,
+                      SimWorker& worker, const EvaluationOptions& options = {}) const;
+  // Evaluates a named set, the controller's parameters and possibly shape scales (on that
+  // shape's scene), on a worker of its own: thread-safe. `model_out` receives the model
+  // it ran on (the task's, or the shaped scene's).
+  Evaluation evaluate_named(const ParameterSet& params, const EvaluationOptions& options = {},
+                            std::shared_ptr<const SharedModel>* model_out = nullptr) const;
+
   // Link masses (kg) and joint names in PoseSample order.
   Eigen::VectorXd link_masses() const;
   std::vector<std::string> link_names() const;
@@ -99,6 +147,15 @@ class TaskEvaluator {
   std::shared_ptr<const SharedModel> model_;
   std::unique_ptr<PlanarHuman> body_;
   int obstacle_geom_ = -1;
+
+  // The rollout of evaluate(), on `body` (the task's, or a shaped scene's).
+  Evaluation evaluate_on(const std::vector<double>& values, const PlanarHuman& body,
+                         SimWorker& worker, const EvaluationOptions& options) const;
+  struct Shapes {
+    std::once_flag once;
+    std::unique_ptr<ShapeSpace> space;
+  };
+  std::unique_ptr<Shapes> shapes_ = std::make_unique<Shapes>();
 };
 
 }  // namespace diverse

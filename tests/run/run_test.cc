@@ -78,30 +78,7 @@ TEST(Run, ResumeAfterKillGivesTheSameSummary) {
   ASSERT_EQ(a.status, 0) << a.output;
 
   // Start the same run and kill -9 it once a checkpoint past generation 2 exists.
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string command = std::string(DIVERSE_BINARY) + " run " + args + " --out " +
-                                killed.string() + " >/dev/null 2>&1";
-    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  long long generation = 0;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
-  while (generation < 2 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    if (fs::exists(killed / "checkpoint.json")) {
-      try {
-        generation = read_json(killed / "checkpoint.json")["optimizer"]["generation"].get<long long>();
-      } catch (...) {
-        // Never torn (atomic rename); a read racing the rename may see it missing.
-      }
-    }
-  }
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_GE(generation, 2);
+  ASSERT_GE(cli_test::run_then_kill(args, killed, 2), 2);
   ASSERT_FALSE(fs::exists(killed / "summary.json")) << "the run finished before it was killed";
 
   Result r = run_cli("resume " + killed.string() + " --threads 2 --quiet --no-render");

@@ -1,10 +1,17 @@
 // Running the built `diverse` tool from end-to-end tests.
 #pragma once
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 
 namespace diverse::cli_test {
 
@@ -38,6 +45,37 @@ inline CliResult run_cli(const std::string& args, const std::string& env = "") {
   const int status = pclose(pipe);
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// Starts `diverse run ARGS --out DIR` in the background and kills it with SIGKILL once its
+// checkpoint has reached `generation` (or after three minutes). Returns the generation the
+// last checkpoint read showed, so the caller can assert that the kill came mid-run.
+inline long long run_then_kill(const std::string& args, const std::filesystem::path& dir,
+                               long long generation) {
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    const std::string command =
+        std::string(DIVERSE_BINARY) + " run " + args + " --out " + dir.string() + " >/dev/null 2>&1";
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  long long reached = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
+  while (reached < generation && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::ifstream in(dir / "checkpoint.json");
+    if (!in) continue;  // not written yet, or a read racing the atomic rename
+    try {
+      reached = nlohmann::json::parse(in)["optimizer"]["generation"].get<long long>();
+    } catch (...) {
+      // Never torn (atomic rename); keep polling.
+    }
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return reached;
 }
 
 }  // namespace diverse::cli_test

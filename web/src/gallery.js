@@ -21,7 +21,10 @@ function fmt(x) {
   if (a >= 1e4 || a < 1e-2) return x.toExponential(2).replace('e+', 'e');
   return x.toPrecision(3);
 }
-const METRIC_NAMES = { hf: 'HF, hands and feet', md: 'MD, mass distance', wja: 'WJA, weighted joint angles' };
+const METRIC_NAMES = {
+  hf: 'HF, hands and feet', md: 'MD, mass distance', wja: 'WJA, weighted joint angles',
+  shape: 'SHAPE, summed link-length differences (m)',
+};
 const el = (tag, attrs = {}, text) => {
   const e = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
@@ -56,7 +59,12 @@ function fillHeader() {
 
 function fillDistances() {
   const dist = data.distances || {};
-  const metrics = ['hf', 'md', 'wja'].filter((m) => Array.isArray(dist[m]));
+  // The shape distance is listed when the bodies differ (runs with --vary shape), and an
+  // objective that combines a motion metric with it ("md+shape") under its own name.
+  const combined = typeof dist.objective === 'string' && dist.objective.endsWith('+shape') ? [dist.objective] : [];
+  const differ = (d) => d.some((row) => row.some((v) => v > 0));
+  const metrics = ['hf', 'md', 'wja', 'shape', ...combined].filter(
+    (m) => Array.isArray(dist[m]) && (m !== 'shape' || differ(dist[m])));
   let current = metrics.includes(dist.objective) ? dist.objective : metrics[0];
   const labels = data.motions.map((m) => m.label);
   const draw = () => {
