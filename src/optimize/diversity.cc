@@ -465,12 +465,16 @@ void DiversityOptimizer::finish_step(int variation) {
   record.evaluations = evaluations_;
   log_.push_back(record);
 
-  if (variation > 0) {
-    paths_[variation].push_back(PathPoint{generation_, steps_, points_[variation]});
-  } else {
-    for (int v = 1; v <= options_.variations; ++v) {
+  // A path records where a variation went: a point for every step that moved it.
+  auto extend_path = [&](int v) {
+    if (points_[v] != paths_[v].back().x) {
       paths_[v].push_back(PathPoint{generation_, steps_, points_[v]});
     }
+  };
+  if (variation > 0) {
+    extend_path(variation);
+  } else {
+    for (int v = 1; v <= options_.variations; ++v) extend_path(v);
   }
   if (callback_) callback_(record);
 }

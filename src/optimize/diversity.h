@@ -142,7 +142,8 @@ struct DiversityRecord {
 };
 nlohmann::json to_json(const DiversityRecord& record);
 
-// A point of a variation's optimization path: where it stands after one of its steps.
+// A point of a variation's optimization path: where it stood after a step that moved it
+// (a step that leaves it where it was adds no point).
 struct PathPoint {
   long long generation = 0;  // 0 for the start at P_0
   long long step = 0;

@@ -280,6 +280,17 @@ TEST_P(BestSample, StandsOnEvaluatedSamplesAndNeverWorsensTheSet) {
   }
   EXPECT_EQ(opt.result().score.constraint.maxCoeff(), 0.0);
   EXPECT_GT(opt.result().score.D, 1.0);
+  // A path has a point per step that moved its variation, and ends where it stands.
+  for (int v = 1; v <= 3; ++v) {
+    const auto& path = opt.paths()[v];
+    EXPECT_EQ(path.front().x, problem.reference());
+    EXPECT_EQ(path.back().x, opt.current_parameters()[v]);
+    EXPECT_LE(path.size(), 13u);
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      EXPECT_NE(path[k].x, path[k - 1].x);
+      EXPECT_GT(path[k].step, path[k - 1].step);
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AllStrategies, BestSample,
