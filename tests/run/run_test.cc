@@ -99,6 +99,11 @@ TEST(RunErrors, OneLineMessagesAndNonZeroExit) {
       {"run " + kTask + " --k -2 --out " + out.string(), "--k: expected a number >= 0"},
       {"run " + kTask + " --generations 0 --out " + out.string(), "--generations: expected an integer >= 1"},
       {"run " + kTask + " --strategy sideways --out " + out.string(), "sideways"},
+      {"run " + kTask + " --constraints soft --out " + out.string(),
+       "--constraints: expected one of dominant, penalty, got 'soft'"},
+      {"run " + kTask + " --point median --out " + out.string(),
+       "--point: expected one of best-sample, mean, got 'median'"},
+      {"run " + kTask + " --sigma0 1.5 --out " + out.string(), "--sigma0: expected a number in (0, 1]"},
       {"run " + kTask + " --metric euclid --out " + out.string(), "--metric: unknown metric 'euclid'"},
       {"resume " + out.string() + "/nowhere", "not a directory"},
   };
