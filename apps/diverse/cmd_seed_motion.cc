@@ -2,8 +2,12 @@
 // constraint penalty, starting from the hand-authored jump the task names
 // ([seed] base), with continuation on the scene object's height where the task asks for
 // it (src/task/seed_motion.h), and writes the parameters to the task's m0 file.
+// `--robustness-check` instead measures a motion (by default the task's M0): its C at
+// the task's timestep and with it halved, and how many random perturbations of its
+// normalized parameters still meet the task.
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -24,9 +28,33 @@ struct SeedArgs {
   std::string out;
   int threads = 1;
   int generations = 0;
+  double sigma = 0;
+  int perturbations = 0;
+  double perturbation_sigma = 0.02;
+  double min_flight_rotation_deg = 0;
+  bool robustness_check = false;
+  std::vector<double> check_sigmas{0.02, 0.05};
+  int check_samples = 32;
 };
 
+void check(const SeedArgs& args) {
+  const Task task = load_task(resolve_task_path(args.task));
+  const TaskEvaluator ev(task);
+  const std::string path = args.start.empty() ? task.m0 : args.start;
+  const ParameterSet p = ev.load_parameters(path);
+  const RobustnessReport r =
+      measure_robustness(task, p, args.check_sigmas, args.check_samples, args.threads);
+  std::printf("%s: %s\n", task.name.c_str(), path.c_str());
+  std::printf("  C = %.6g at the task's timestep, %.6g with it halved\n", r.constraint,
+              r.constraint_fine);
+  for (const RobustnessReport::Level& l : r.levels) {
+    std::printf("  sigma %.3f: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
+                l.samples, 100 * l.fraction());
+  }
+}
+
 void run(const SeedArgs& args) {
+  if (args.robustness_check) return check(args);
   const Task task = load_task(resolve_task_path(args.task));
   const TaskEvaluator ev(task);
   const std::string start_path = args.start.empty() ? task.seed.base : args.start;
@@ -37,31 +65,71 @@ void run(const SeedArgs& args) {
   SeedOptions options;
   options.threads = args.threads;
   options.generations = args.generations;
+  options.sigma = args.sigma;
+  options.perturbations = args.perturbations;
+  options.perturbation_sigma = args.perturbation_sigma;
+  options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
   options.log = [](const std::string& line) { std::printf("%s\n", line.c_str()); std::fflush(stdout); };
   const SeedResult r = seed_motion(task, start, options);
   // The task's m0 file only ever holds a motion that meets the task; a search that falls
-  // short writes its best attempt beside it, to continue from with --start.
+  // short writes its best attempt beside it, to continue from with --start. With
+  // perturbations, a robust near miss that ranks above the motion that meets the task is
+  // written there too: it is the better place to continue from.
   const bool met = r.constraint == 0;
-  std::string out = args.out;
-  if (out.empty()) {
-    out = task.m0;
-    if (!met) {
-      const std::string suffix = ".m0.json";
-      out = out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0
-                ? out.substr(0, out.size() - suffix.size()) + ".partial.json"
-                : out + ".partial";
-    }
+  const std::string m0_path = args.out.empty() ? task.m0 : args.out;
+  const std::string suffix = ".m0.json";
+  const std::string stem =
+      m0_path.size() > suffix.size() &&
+              m0_path.compare(m0_path.size() - suffix.size(), suffix.size(), suffix) == 0
+          ? m0_path.substr(0, m0_path.size() - suffix.size())
+          : (m0_path.size() > 5 && m0_path.compare(m0_path.size() - 5, 5, ".json") == 0
+                 ? m0_path.substr(0, m0_path.size() - 5)
+                 : m0_path);
+  const std::string partial_path = stem + ".partial.json";
+  std::string command = "diverse seed-motion " + task.name + " --start " + start_path;
+  if (args.generations > 0) command += " --generations " + std::to_string(args.generations);
+  if (args.sigma > 0) {
+    char sigma[32];
+    std::snprintf(sigma, sizeof(sigma), "%g", args.sigma);
+    command += std::string(" --sigma ") + sigma;
   }
-  nlohmann::json j;
-  j["task"] = task.name;
-  j["constraint"] = r.constraint;
-  j["margin"] = r.margin;
-  j["found_by"] = "diverse seed-motion " + task.name + " (from " + start_path + ", " +
-                  std::to_string(r.evaluations) + " rollouts)";
-  j["parameters"] = r.parameters.to_json();
-  write_json_atomic(out, j);
-  std::printf("C=%.6g margin=%.3f fell=%d evaluations=%lld seconds=%.1f -> %s\n", r.constraint,
-              r.margin, r.fell ? 1 : 0, r.evaluations, r.seconds, out.c_str());
+  if (args.perturbations > 0) {
+    char sigma[32];
+    std::snprintf(sigma, sizeof(sigma), "%g", args.perturbation_sigma);
+    command += " --perturbations " + std::to_string(args.perturbations) +
+               " --perturbation-sigma " + sigma;
+  }
+  if (args.min_flight_rotation_deg > 0) {
+    char deg[32];
+    std::snprintf(deg, sizeof(deg), "%g", args.min_flight_rotation_deg);
+    command += std::string(" --min-flight-rotation ") + deg;
+  }
+  command += " (" + std::to_string(r.evaluations) + " rollouts)";
+  auto write = [&](const std::string& path, const ParameterSet& p, double constraint) {
+    nlohmann::json j;
+    j["task"] = task.name;
+    j["constraint"] = constraint;
+    j["margin"] = r.margin;
+    if (args.perturbations > 0) j["robustness"] = r.robustness;
+    j["found_by"] = command;
+    j["parameters"] = p.to_json();
+    write_json_atomic(path, j);
+  };
+  const std::string out = met ? m0_path : partial_path;
+  write(out, r.parameters, r.constraint);
+  std::printf("C=%.6g margin=%.3f robustness=%.3f fell=%d evaluations=%lld seconds=%.1f -> %s\n",
+              r.constraint, r.margin, r.robustness, r.fell ? 1 : 0, r.evaluations, r.seconds,
+              out.c_str());
+  if (met && !r.lowest_mean_meets && args.perturbations > 0) {
+    nlohmann::json j;
+    j["task"] = task.name;
+    j["objective"] = r.lowest_mean_f;
+    j["found_by"] = command;
+    j["parameters"] = r.lowest_mean.to_json();
+    write_json_atomic(partial_path, j);
+    std::printf("a more robust candidate that does not meet the task yet (mean C = %.6g) -> %s\n",
+                r.lowest_mean_f, partial_path.c_str());
+  }
   if (!met)
     throw UserError(task.file + ": no motion meeting the task was found (best C = " +
                     std::to_string(r.constraint) + "); continue with `diverse seed-motion " +
@@ -78,6 +146,27 @@ void install(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 256));
   cmd->add_option("--generations", args->generations,
                   "CMA-ES generations per stage (default: the task's seed.generations)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--sigma", args->sigma,
+                  "Initial CMA-ES step, normalized (default: the task's seed.sigma)")
+      ->check(CLI::Range(1e-6, 1.0));
+  cmd->add_option("--perturbations", args->perturbations,
+                  "Robustness term: perturbed rollouts per candidate (0 = off)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--perturbation-sigma", args->perturbation_sigma,
+                  "Robustness term: their standard deviation, in normalized units")
+      ->check(CLI::Range(1e-6, 1.0));
+  cmd->add_option("--min-flight-rotation", args->min_flight_rotation_deg,
+                  "Require this root rotation (degrees, backwards positive) between take-off and "
+                  "touch-down while searching (0 = none)")
+      ->check(CLI::Range(0.0, 720.0));
+  cmd->add_flag("--robustness-check", args->robustness_check,
+                "Measure a motion instead of searching (default: the task's M0, or --start)");
+  cmd->add_option("--check-sigmas", args->check_sigmas,
+                  "Robustness check: perturbation sizes, normalized (default 0.02 0.05)")
+      ->check(CLI::Range(1e-6, 1.0));
+  cmd->add_option("--check-samples", args->check_samples,
+                  "Robustness check: perturbations per size (default 32)")
       ->check(CLI::Range(1, 100000));
   cmd->callback([args] { run(*args); });
 }

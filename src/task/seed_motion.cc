@@ -17,31 +17,113 @@ namespace {
 
 constexpr double kMarginCap = 0.1;  // m; slack beyond this earns nothing more
 constexpr int kPatience = 25;       // generations without improvement that end the last stage
+// An intermediate continuation stage moves on once a candidate meets its task and at
+// least this fraction of its perturbations do too (when perturbations are on).
+constexpr double kStageRobustness = 0.5;
+// Stream keys of the perturbation seeds (ASCII "seedrob" and "measrob").
+constexpr std::uint64_t kSeedPerturbations = 0x73656564726f62;
+constexpr std::uint64_t kMeasurePerturbations = 0x6d656173726f62;
 
-struct Scored {
-  double f = 0, constraint = 0, margin = 0;
-  bool fell = true;
+// Reflection into [0, 1] with period 2, as the bounded CMA-ES maps its genotypes.
+double reflect01(double g) {
+  double t = std::fmod(g, 2.0);
+  if (t < 0) t += 2.0;
+  return t <= 1.0 ? t : 2.0 - t;
+}
+
+// Standard normal directions, direction k from derive_seed(seed, {k}).
+std::vector<Eigen::VectorXd> directions(int dim, int count, std::uint64_t seed) {
+  std::vector<Eigen::VectorXd> out;
+  for (int k = 0; k < count; ++k) {
+    Rng rng(derive_seed(seed, {static_cast<std::uint64_t>(k)}));
+    Eigen::VectorXd z(dim);
+    for (int i = 0; i < dim; ++i) z[i] = rng.normal();
+    out.push_back(std::move(z));
+  }
+  return out;
+}
+
+Eigen::VectorXd displaced(const Eigen::VectorXd& x, double sigma, const Eigen::VectorXd& z) {
+  Eigen::VectorXd y(x.size());
+  for (int i = 0; i < x.size(); ++i) y[i] = reflect01(x[i] + sigma * z[i]);
+  return y;
+}
+
+// What the objective needs besides the evaluators: the robustness term's fixed
+// perturbation directions (empty = off) and their scale.
+struct Robustness {
+  std::vector<Eigen::VectorXd> directions;
+  double sigma = 0;
 };
 
-// Scores x on the task at its timestep and again with the timestep halved, and sums the
-// two constraint values: a motion counts as meeting the task only if it does so at both
-// timesteps, which keeps input motions away from knife-edge landings that depend on
-// integration details. The sum (rather than checking the fine timestep only once the
-// coarse one is met) keeps the landscape graded for CMA-ES: a candidate that meets the
-// task coarsely but falls finely is ranked among the falls by how early it fell.
+// The perturbation directions of generation `generation` (0: the starting point) of
+// continuation stage `stage`: shared by the generation's candidates, fresh in every
+// generation, so that the search cannot tune a motion to a few fixed directions.
+Robustness generation_robustness(const Task& task, int dim, const SeedOptions& options,
+                                 size_t stage, long long generation) {
+  Robustness r;
+  r.sigma = options.perturbation_sigma;
+  r.directions =
+      directions(dim, options.perturbations,
+                 derive_seed(task.seed.seed, {kSeedPerturbations, stage,
+                                              static_cast<std::uint64_t>(generation)}));
+  return r;
+}
+
+// C of one rollout as the search sees it: the task's C plus, when the search asks for a
+// minimum rotation of the root between take-off and touch-down, K_c d^2 for a shortfall
+// of d rad (the task's own weight, as for any other constraint).
+double seed_constraint(const Evaluation& e, const Task& task, const SeedOptions& options) {
+  double c = e.constraint;
+  if (options.min_flight_rotation > 0 && !e.fell) {
+    const double d = std::max(0.0, options.min_flight_rotation - e.summary.rotation_flight);
+    c += task.constraints.weight * d * d;
+  }
+  return c;
+}
+
+struct Scored {
+  double f = 0;
+  double constraint = 0;  // C at the task's timestep plus C with it halved
+  double margin = 0;      // smallest constraint_margin of the two
+  double met = 0;         // fraction of the perturbations with C = 0 (0 if none)
+  bool fell = true;
+  bool meets() const { return constraint == 0; }
+};
+
+// Scores x on the task at its timestep and again with the timestep halved: a motion
+// counts as meeting the task only if it does so at both timesteps, which keeps input
+// motions away from knife-edge landings that depend on integration details. With
+// perturbations, x is also simulated at each x + sigma_r z_k, and f is the mean C over
+// all these rollouts: the expected penalty under small parameter changes, a smoothed
+// landscape on which CMA-ES moves towards regions where whole neighbourhoods meet the
+// task, rather than towards single lucky points. Means keep the landscape graded: a
+// candidate that meets the task coarsely but falls finely ranks among the falls by how
+// early it fell. When every rollout meets the task, f is -robustness * min(margin, cap).
 Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::VectorXd& x,
-             SimWorker& worker, SimWorker& fine_worker) {
+             SimWorker& worker, SimWorker& fine_worker, const Robustness& robust,
+             const SeedOptions& seed) {
   EvaluationOptions options;
   options.samples_per_phase = 0;
   const Evaluation e = ev.evaluate_normalized(x, worker, options);
   const Evaluation f = fine.evaluate_normalized(x, fine_worker, options);
   Scored s;
-  s.constraint = e.constraint + f.constraint;
+  s.constraint = seed_constraint(e, ev.task(), seed) + seed_constraint(f, fine.task(), seed);
   s.fell = e.fell || f.fell;
   s.margin = std::min(e.failed ? -1 : constraint_margin(ev.task(), e.summary),
                       f.failed ? -1 : constraint_margin(fine.task(), f.summary));
-  const double reward = s.constraint == 0 ? std::min(std::max(s.margin, 0.0), kMarginCap) : 0;
-  s.f = s.constraint - ev.task().seed.robustness * reward;
+  double sum = s.constraint;
+  int met = 0;
+  for (const Eigen::VectorXd& z : robust.directions) {
+    const double c = seed_constraint(
+        ev.evaluate_normalized(displaced(x, robust.sigma, z), worker, options), ev.task(), seed);
+    sum += c;
+    if (c == 0) ++met;
+  }
+  const auto n = static_cast<double>(robust.directions.size());
+  if (n > 0) s.met = met / n;
+  s.f = sum / (2 + n);
+  if (sum == 0) s.f = -ev.task().seed.robustness * std::min(std::max(s.margin, 0.0), kMarginCap);
   return s;
 }
 
@@ -51,10 +133,16 @@ Task halved(const Task& task, const mjModel* m) {
   return t;
 }
 
+// The task with the continuation object at `height`. When the landing controller aims
+// at the top of that object (a box to land on), its landing surface moves with it.
 Task with_height(const Task& task, double height) {
   Task t = task;
   for (SceneObject& o : t.objects) {
-    if (o.name == task.seed.object) o.height = height;
+    if (o.name != task.seed.object) continue;
+    if (o.kind == "box" && task.controller_config.landing_height == o.height) {
+      t.controller_config.landing_height = height;
+    }
+    o.height = height;
   }
   return t;
 }
@@ -65,12 +153,13 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   const auto t0 = std::chrono::steady_clock::now();
   SeedResult result;
   result.parameters = start;
+  result.lowest_mean = start;
   Eigen::VectorXd x = start.normalized();
   std::vector<double> heights = task.seed.heights;
   if (task.seed.object.empty()) heights = {-1};
   const int generations = options.generations > 0 ? options.generations : task.seed.generations;
   ThreadPool pool(std::max(1, options.threads));
-  char line[256];
+  char line[320];
 
   for (size_t stage = 0; stage < heights.size(); ++stage) {
     const bool last = stage + 1 == heights.size();
@@ -83,20 +172,40 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       fine_workers.push_back(fine.make_worker());
     }
 
-    Scored best = score(ev, fine, x, *workers[0], *fine_workers[0]);
+    const int dim = static_cast<int>(x.size());
+    Robustness robust = generation_robustness(task, dim, options, stage, 0);
+    // Done with a stage: an intermediate one as soon as a candidate meets its task (with
+    // enough of its neighbourhood, when perturbations are on); the last one when the
+    // candidate with the lowest objective meets the task and nothing has improved for
+    // kPatience generations (or after the generation budget).
+    auto good_enough = [&](const Scored& v) {
+      return v.meets() && (robust.directions.empty() || v.met >= kStageRobustness);
+    };
+
+    Scored best = score(ev, fine, x, *workers[0], *fine_workers[0], robust, options);
     Eigen::VectorXd best_x = x;
-    ++result.evaluations;
+    bool have_valid = best.meets();
+    Scored best_valid = best;
+    Eigen::VectorXd best_valid_x = x;
+    result.evaluations += static_cast<long long>(2 + robust.directions.size());
     if (options.log) {
-      std::snprintf(line, sizeof(line), "stage %zu (height %.3f m): start C=%.6g margin=%.3f",
-                    stage, heights[stage], best.constraint, best.margin);
+      std::snprintf(line, sizeof(line),
+                    "stage %zu (height %.3f m): start f=%.6g C=%.6g margin=%.3f met=%.3f", stage,
+                    heights[stage], best.f, best.constraint, best.margin, best.met);
       options.log(line);
     }
-    if (!last && best.constraint == 0) continue;
+    if (last) {
+      result.lowest_mean = start;
+      result.lowest_mean.set_normalized(x);
+      result.lowest_mean_f = best.f;
+      result.lowest_mean_meets = best.meets();
+    }
+    if (!last && good_enough(best)) continue;
 
     CmaesOptions co;
     co.dim = static_cast<int>(x.size());
     co.popsize = task.seed.popsize;
-    co.sigma0 = task.seed.sigma;
+    co.sigma0 = options.sigma > 0 ? options.sigma : task.seed.sigma;
     co.seed = derive_seed(task.seed.seed, {static_cast<std::uint64_t>(stage)});
     co.bounded = true;
     co.lower = 0;
@@ -106,10 +215,11 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     int since_improvement = 0;
     while (es.stop_reason() == StopReason::kNone) {
       const std::vector<Eigen::VectorXd>& xs = es.ask();
+      robust = generation_robustness(task, dim, options, stage, es.generation() + 1);
       std::vector<Scored> scores(xs.size());
       pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
         const auto w = static_cast<std::size_t>(worker);
-        scores[k] = score(ev, fine, xs[k], *workers[w], *fine_workers[w]);
+        scores[k] = score(ev, fine, xs[k], *workers[w], *fine_workers[w], robust, options);
       });
       std::vector<double> f(xs.size());
       bool improved = false;
@@ -120,23 +230,38 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
           best_x = xs[k];
           improved = true;
         }
+        if (scores[k].meets() && (!have_valid || scores[k].f < best_valid.f)) {
+          have_valid = true;
+          best_valid = scores[k];
+          best_valid_x = xs[k];
+          improved = true;
+        }
       }
-      result.evaluations += static_cast<long long>(xs.size());
+      result.evaluations += static_cast<long long>(xs.size() * (2 + robust.directions.size()));
       es.tell(f);
       since_improvement = improved ? 0 : since_improvement + 1;
       if (options.log) {
+        std::vector<double> sorted = f;
+        std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2),
+                         sorted.end());
+        const double median = sorted[sorted.size() / 2];
+        const Scored& b = have_valid ? best_valid : best;
         std::snprintf(line, sizeof(line),
-                      "stage %zu gen %lld: best f=%.6g C=%.6g margin=%.3f sigma=%.4f", stage,
-                      es.generation(), best.f, best.constraint, best.margin, es.sigma());
+                      "stage %zu gen %lld: best f=%.6g C=%.6g margin=%.3f met=%.3f%s; lowest f=%.6g "
+                      "median f=%.6g sigma=%.4f",
+                      stage, es.generation(), b.f, b.constraint, b.margin, b.met,
+                      have_valid ? "" : " (none meets the task yet)", best.f, median, es.sigma());
         options.log(line);
       }
-      if (!last && best.constraint == 0) break;
-      if (last && best.constraint == 0 &&
-          (task.seed.robustness == 0 || since_improvement >= kPatience)) {
-        break;
-      }
+      if (!last && have_valid && good_enough(best_valid)) break;
+      if (last && best.meets() && since_improvement >= kPatience) break;
     }
-    x = best_x;
+    x = have_valid ? best_valid_x : best_x;
+    if (last) {
+      result.lowest_mean.set_normalized(best_x);
+      result.lowest_mean_f = best.f;
+      result.lowest_mean_meets = best.meets();
+    }
   }
 
   // The result on the full task.
@@ -144,14 +269,57 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   const TaskEvaluator fine(halved(task, ev.model().get()));
   auto worker = ev.make_worker();
   auto fine_worker = fine.make_worker();
-  const Scored final_score = score(ev, fine, x, *worker, *fine_worker);
+  const Robustness robust =
+      generation_robustness(task, static_cast<int>(x.size()), options, heights.size() - 1, 0);
+  const Scored final_score = score(ev, fine, x, *worker, *fine_worker, robust, options);
   result.parameters.set_normalized(x);
   result.constraint = final_score.constraint;
   result.margin = final_score.margin;
+  result.robustness = final_score.met;
   result.fell = final_score.fell;
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
+}
+
+std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,
+                                     std::uint64_t seed) {
+  std::vector<Eigen::VectorXd> out;
+  for (const Eigen::VectorXd& z : directions(static_cast<int>(x.size()), count, seed)) {
+    out.push_back(displaced(x, sigma, z));
+  }
+  return out;
+}
+
+RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
+                                    const std::vector<double>& sigmas, int samples, int threads) {
+  const TaskEvaluator ev(task);
+  const TaskEvaluator fine(halved(task, ev.model().get()));
+  ThreadPool pool(std::max(1, threads));
+  std::vector<std::unique_ptr<SimWorker>> workers;
+  for (int w = 0; w < pool.size(); ++w) workers.push_back(ev.make_worker());
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  RobustnessReport report;
+  const Eigen::VectorXd x = parameters.normalized();
+  report.constraint = ev.evaluate_normalized(x, *workers[0], options).constraint;
+  auto fine_worker = fine.make_worker();
+  report.constraint_fine = fine.evaluate_normalized(x, *fine_worker, options).constraint;
+  for (size_t level = 0; level < sigmas.size(); ++level) {
+    const std::vector<Eigen::VectorXd> xs =
+        perturb(x, sigmas[level], samples,
+                derive_seed(task.seed.seed, {kMeasurePerturbations, static_cast<std::uint64_t>(level)}));
+    std::vector<double> c(xs.size());
+    pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
+      c[k] = ev.evaluate_normalized(xs[k], *workers[static_cast<std::size_t>(worker)], options).constraint;
+    });
+    RobustnessReport::Level l;
+    l.sigma = sigmas[level];
+    l.samples = samples;
+    l.met = static_cast<int>(std::count(c.begin(), c.end(), 0.0));
+    report.levels.push_back(l);
+  }
+  return report;
 }
 
 }  // namespace diverse

@@ -3,24 +3,40 @@
 // Starts from a hand-authored small in-place jump and runs CMA-ES (optimize/cmaes.h) on
 // the task's constraint penalty C, as the paper does for each jump. With continuation
 // (Jump onto, Jump over), the scene object's height is raised in stages, each stage
-// starting from the previous stage's best; intermediate stages stop as soon as C = 0.
+// starting from the previous stage's best; intermediate stages stop as soon as a
+// candidate meets the stage's task (with half of its perturbations, when those are on).
 //
-// Objective: f = C - robustness * min(margin, 0.1 m), where margin is the smallest slack
-// inside the allowed region (task/constraints.h, constraint_margin). Outside the region f
-// is the penalty alone (margin < 0 is clipped to 0 there); inside it a small reward for
-// slack prefers input motions that land near the middle of their box or clear their
-// obstacle with room, so the diversity optimizer starts from a motion with margin.
-// With robustness = 0 this is the penalty alone. A candidate that meets the task is
-// simulated again with the timestep halved and counts as meeting it only if it does so
-// there too (C is then the larger of the two), so input motions do not hinge on
-// integration details.
+// Objective: every candidate is simulated at the task's timestep and with it halved, and
+// counts as meeting the task only if it does so at both, so input motions do not hinge
+// on integration details. f is the mean C of these rollouts; when all of them meet the
+// task, f = -robustness * min(margin, 0.1 m), where margin is the smallest slack inside
+// the allowed region (task/constraints.h, constraint_margin): a small reward for slack
+// prefers input motions that land near the middle of their box or clear their obstacle
+// with room, so the diversity optimizer starts from a motion with margin.
 //
-// Deterministic for a given task seed: CMA-ES draws from seeds derived from it, and the
-// generation's samples are evaluated in parallel into fixed slots.
+// Robustness (ours): the diversity optimizer starts from M0 and samples around it, so an
+// input motion is only useful if some of its neighbourhood also meets the task. With
+// SeedOptions::perturbations = P > 0, every candidate is also simulated at P
+// perturbations x + sigma_r z_k of its normalized parameters (reflected into [0, 1] as
+// the optimizer's samples are; the same directions z_k for every candidate of a
+// generation, so candidates are ranked on equal terms, and fresh ones in every
+// generation, so the search cannot tune a motion to a few fixed directions), and the
+// objective is the mean C over the 2 + P rollouts: the expected penalty under small
+// parameter changes. The result is the best candidate that meets the task at both
+// timesteps (ranked by that mean), so a neighbourhood that meets the task is preferred
+// to a lucky point. measure_robustness() reports the fraction of another set of
+// perturbations that meet the task.
+//
+// Deterministic for a given task seed: CMA-ES draws from seeds derived from it, the
+// perturbations likewise, and the generation's samples are evaluated in parallel into
+// fixed slots.
 #pragma once
 
+#include <Eigen/Dense>
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "control/parameters.h"
 #include "task/task.h"
@@ -30,20 +46,59 @@ namespace diverse {
 struct SeedOptions {
   int threads = 1;
   int generations = 0;  // per stage; 0 = the task's seed.generations
+  double sigma = 0;     // initial CMA-ES step (normalized); 0 = the task's seed.sigma
+  // Robustness term (see above): perturbations per candidate (0 = off) and their
+  // standard deviation in normalized units.
+  int perturbations = 0;
+  double perturbation_sigma = 0.02;
+  // A requirement of the search, not of the task: the root turns at least this much (rad,
+  // backwards positive) between take-off and touch-down, else K_c d^2 is added to C for
+  // a shortfall of d. 0 = none. Makes a backflip turn in the air rather than on the ground.
+  double min_flight_rotation = 0;
   // Called after every generation with a one-line progress report.
   std::function<void(const std::string&)> log;
 };
 
 struct SeedResult {
   ParameterSet parameters;
-  double constraint = 0;  // C of the result on the full task
+  double constraint = 0;  // C of the result on the full task (sum over both timesteps)
   double margin = 0;      // constraint_margin of the result (m)
+  double robustness = 0;  // fraction of the last stage's fixed perturbations met (0 if off)
   bool fell = true;
-  long long evaluations = 0;
+  long long evaluations = 0;  // rollouts simulated (2 + perturbations per candidate)
+  // The last stage's candidate with the lowest objective, whether or not it meets the task
+  // (with perturbations, a robust near miss can rank above a fragile motion that meets
+  // it): the place to continue a search from.
+  ParameterSet lowest_mean;
+  double lowest_mean_f = 0;
+  bool lowest_mean_meets = false;
   double seconds = 0;
 };
 
 // `start` holds the starting parameters (names and values of the task's controller).
 SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOptions& options);
+
+// `count` perturbations of the normalized vector x: x + sigma * N(0, I), each coordinate
+// reflected into [0, 1] (period 2, as the bounded CMA-ES does). Perturbation k draws from
+// derive_seed(seed, {k}) only, so the set does not depend on threads or on `count`.
+std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,
+                                     std::uint64_t seed);
+
+// How much of a motion's neighbourhood meets the task: C at the task's timestep and with
+// it halved, and, for each sigma, how many of `samples` perturbations (perturb() with the
+// task's seed.seed) have C = 0 at the task's timestep.
+struct RobustnessReport {
+  double constraint = 0;       // C at the task's timestep
+  double constraint_fine = 0;  // C with the timestep halved
+  struct Level {
+    double sigma = 0;  // normalized
+    int samples = 0;
+    int met = 0;       // perturbations with C = 0
+    double fraction() const { return samples > 0 ? static_cast<double>(met) / samples : 0; }
+  };
+  std::vector<Level> levels;
+};
+RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
+                                    const std::vector<double>& sigmas, int samples, int threads);
 
 }  // namespace diverse

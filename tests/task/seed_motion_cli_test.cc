@@ -1,5 +1,6 @@
 // `diverse seed-motion` keeps the task's m0 file for motions that meet the task: a search
-// that falls short writes its best attempt beside it and says how to continue.
+// that falls short writes its best attempt beside it and says how to continue. With
+// --robustness-check it measures a motion and its neighbourhood instead of searching.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -35,6 +36,28 @@ TEST(SeedMotionCli, AShortSearchThatFailsWritesAPartialFileNotTheM0) {
   EXPECT_GT(read_json(dir / "short.partial.json")["constraint"].get<double>(), 0.0);
   EXPECT_NE(r.output.find("no motion meeting the task was found"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--start " + (dir / "short.partial.json").string()), std::string::npos)
+      << r.output;
+}
+
+TEST(SeedMotionCli, RobustnessCheckReportsBothTimestepsAndTheNeighbourhood) {
+  const auto r = cli_test::run_cli(
+      "seed-motion jump_high --robustness-check --check-sigmas 1e-6 0.5 --check-samples 3");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("C = 0 at the task's timestep, 0 with it halved"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("sigma 0.000: 3 of 3 perturbations meet the task (100 %)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("sigma 0.500: 0 of 3 perturbations meet the task (0 %)"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST(SeedMotionCli, RobustnessCheckOfAMissingFileSaysWhichFile) {
+  const auto r = cli_test::run_cli("seed-motion jump_high --robustness-check --start /nonexistent/m0.json");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("diverse: error: /nonexistent/m0.json: cannot read the parameter file"),
+            std::string::npos)
       << r.output;
 }
 

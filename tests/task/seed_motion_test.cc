@@ -1,0 +1,106 @@
+// Searching for input motions: the perturbations the robustness term and the robustness
+// check use stay in the normalized box, follow their seed alone and have the asked-for
+// spread; the robustness check tells a motion's neighbourhood apart from random
+// controllers; the search's own requirement on the flight rotation is enforced; and the
+// robustness term keeps the search independent of the number of threads.
+#include "task/seed_motion.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "task/evaluate.h"
+
+namespace diverse {
+namespace {
+
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
+
+TEST(Perturb, StaysInTheBoxAndReflectsAtItsBounds) {
+  // The direction of sample 0 of seed 9, read off a point far from the bounds.
+  const Eigen::VectorXd mid = Eigen::VectorXd::Constant(6, 0.5);
+  const Eigen::VectorXd z = (perturb(mid, 1e-3, 1, 9)[0] - mid) / 1e-3;
+  // Scaled so that the largest step is 0.4: from 0.1 and 0.9 some steps cross a bound and
+  // come back into the box as mirror images.
+  const double sigma = 0.4 / z.cwiseAbs().maxCoeff();
+  const Eigen::VectorXd lo = perturb(Eigen::VectorXd::Constant(6, 0.1), sigma, 1, 9)[0];
+  const Eigen::VectorXd hi = perturb(Eigen::VectorXd::Constant(6, 0.9), sigma, 1, 9)[0];
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_NEAR(lo[i], std::fabs(0.1 + sigma * z[i]), 1e-9) << i;
+    EXPECT_NEAR(hi[i], 1 - std::fabs(0.9 + sigma * z[i] - 1), 1e-9) << i;
+  }
+  // Steps of any size, from anywhere in the box, stay in it.
+  Eigen::VectorXd x(4);
+  x << 0.0, 1.0, 0.5, 0.999;
+  for (const Eigen::VectorXd& y : perturb(x, 0.7, 50, 3)) {
+    EXPECT_GE(y.minCoeff(), 0.0);
+    EXPECT_LE(y.maxCoeff(), 1.0);
+  }
+}
+
+TEST(Perturb, DependsOnTheSeedOnlyAndHasTheAskedSpread) {
+  const Eigen::VectorXd x = Eigen::VectorXd::Constant(90, 0.5);
+  const auto a = perturb(x, 0.02, 3, 11), b = perturb(x, 0.02, 200, 11), c = perturb(x, 0.02, 3, 12);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(a[k], b[k]) << k;  // sample k does not depend on count
+  EXPECT_NE(a[0], c[0]);
+  double sum = 0, sum2 = 0;
+  for (const Eigen::VectorXd& y : b) {
+    sum += (y - x).sum();
+    sum2 += (y - x).squaredNorm();
+  }
+  const double n = 200.0 * 90;
+  EXPECT_NEAR(sum / n, 0.0, 0.001);
+  EXPECT_NEAR(std::sqrt(sum2 / n), 0.02, 0.001);
+}
+
+TEST(Robustness, TellsAMotionsNeighbourhoodFromRandomControllers) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const RobustnessReport r = measure_robustness(task, m0, {1e-9, 0.5}, 4, 2);
+  EXPECT_EQ(r.constraint, 0.0);
+  EXPECT_EQ(r.constraint_fine, 0.0);
+  ASSERT_EQ(r.levels.size(), 2u);
+  EXPECT_EQ(r.levels[0].sigma, 1e-9);
+  EXPECT_EQ(r.levels[0].samples, 4);
+  EXPECT_EQ(r.levels[0].met, 4);  // a billionth of the ranges changes nothing that matters
+  EXPECT_EQ(r.levels[1].met, 0);  // half the ranges: a random controller
+  EXPECT_EQ(r.levels[1].fraction(), 0.0);
+}
+
+TEST(SeedMotion, AFlightRotationRequirementTheMotionMissesIsAViolation) {
+  // The backflip M0 meets its task, but no candidate near it turns a full 2 pi between
+  // take-off and touch-down.
+  const Task task = load_task(kTasks + "backflip.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.min_flight_rotation = 2 * M_PI;
+  const SeedResult r = seed_motion(task, m0, options);
+  EXPECT_GT(r.constraint, 0.0);
+  EXPECT_EQ(r.evaluations, 2 * (1 + task.seed.popsize));
+}
+
+TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  SeedOptions options;
+  options.generations = 1;
+  options.perturbations = 2;
+  options.perturbation_sigma = 0.02;
+  options.threads = 1;
+  const SeedResult one = seed_motion(task, m0, options);
+  options.threads = 2;
+  const SeedResult two = seed_motion(task, m0, options);
+  EXPECT_EQ(one.parameters.values(), two.parameters.values());
+  EXPECT_EQ(one.robustness, two.robustness);
+  EXPECT_EQ(one.lowest_mean.values(), two.lowest_mean.values());
+  EXPECT_EQ(one.evaluations, 4 * (1 + task.seed.popsize));
+}
+
+}  // namespace
+}  // namespace diverse
