@@ -199,6 +199,15 @@ TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
   EXPECT_EQ(back.seed, o.seed);
 }
 
+// Parameterized suites run once per strategy, named after it ("roundrobin", ...).
+const auto kAllStrategies = ::testing::Values(
+    DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive, DiversityStrategy::kJoint);
+std::string strategy_test_name(const ::testing::TestParamInfo<DiversityStrategy>& info) {
+  std::string name = to_string(info.param);
+  name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+  return name;
+}
+
 // ---- Constraint rules ------------------------------------------------------------------
 
 // A constraint weight of 1 is far too weak for the distances of points spread over the
@@ -231,14 +240,7 @@ TEST_P(ConstraintRules, DominantKeepsTheResultFeasibleWherePenaltyDoesNot) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllStrategies, ConstraintRules,
-                         ::testing::Values(DiversityStrategy::kRoundRobin,
-                                           DiversityStrategy::kProgressive,
-                                           DiversityStrategy::kJoint),
-                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
-                           std::string name = to_string(p.param);
-                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
-                           return name;
-                         });
+                         kAllStrategies, strategy_test_name);
 
 // ---- Where a variation stands ------------------------------------------------------------
 
@@ -294,14 +296,7 @@ TEST_P(BestSample, StandsOnEvaluatedSamplesAndNeverWorsensTheSet) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllStrategies, BestSample,
-                         ::testing::Values(DiversityStrategy::kRoundRobin,
-                                           DiversityStrategy::kProgressive,
-                                           DiversityStrategy::kJoint),
-                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
-                           std::string name = to_string(p.param);
-                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
-                           return name;
-                         });
+                         kAllStrategies, strategy_test_name);
 
 TEST(DiversityOptions, VariationPointNames) {
   EXPECT_EQ(parse_variation_point("best-sample"), VariationPoint::kBestSample);
@@ -568,14 +563,7 @@ TEST_P(DiversityStrategies, CheckpointResumeMatchesUninterruptedRun) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, DiversityStrategies,
-                         ::testing::Values(DiversityStrategy::kRoundRobin,
-                                           DiversityStrategy::kProgressive,
-                                           DiversityStrategy::kJoint),
-                         [](const ::testing::TestParamInfo<DiversityStrategy>& p) {
-                           std::string name = to_string(p.param);
-                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
-                           return name;
-                         });
+                         kAllStrategies, strategy_test_name);
 
 TEST(DiversityCheckpoint, RejectsACheckpointOfAnotherProblem) {
   const BallProblem problem(2, 0.3);
