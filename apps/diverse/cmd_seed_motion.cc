@@ -47,6 +47,12 @@ void check(const SeedArgs& args) {
   std::printf("%s: %s\n", task.name.c_str(), path.c_str());
   std::printf("  C = %.6g at the task's timestep, %.6g with it halved\n", r.constraint,
               r.constraint_fine);
+  if (std::isnan(r.landing_shift)) {
+    std::printf("  landing spots at the two timesteps: not compared (a fall)\n");
+  } else {
+    std::printf("  landing spots at the two timesteps differ by %.3f m (input motions: at most %.2f m)\n",
+                r.landing_shift, kTimestepAgreement);
+  }
   for (const RobustnessReport::Level& l : r.levels) {
     std::printf("  sigma %.3f: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
                 l.samples, 100 * l.fraction());

@@ -63,9 +63,10 @@ void run(const SimulateArgs& args) {
     std::printf("  phase %-7s begins at %.3f s\n", jump_phase_name(p), e.phases.begin[p]);
   }
   const MotionSummary& s = e.summary;
-  std::printf("peak COM %.3f m, feet end at x %.3f m z %.3f m, rotation %.1f deg (flight %.1f), "
-              "min obstacle distance %.3f m, %d steps, %.3f s\n",
-              s.peak_com_z, s.feet_x, s.feet_z, s.rotation_total * 180 / M_PI,
+  std::printf("peak COM %.3f m, feet touch down at x %.3f m z %.3f m and end at x %.3f m z %.3f m, "
+              "rotation %.1f deg (flight %.1f), min obstacle distance %.3f m, %d steps, %.3f s\n",
+              s.peak_com_z, s.touchdown_feet_x, s.touchdown_feet_z, s.feet_x, s.feet_z,
+              s.rotation_total * 180 / M_PI,
               s.rotation_flight * 180 / M_PI, s.min_clearance, e.stats.steps, e.stats.time);
 
   if (!args.no_film) {

@@ -23,23 +23,33 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
   add("fall", motion.fell ? 1 : 0, motion.fell ? c.fall_penalty * (2 - progress) : 0);
   report.fell = motion.fell;
 
+  // The larger violation of the feet at touch-down and at rest.
+  auto at_touchdown_and_rest = [&](auto violation) {
+    return std::max(violation(motion.touchdown_feet_x, motion.touchdown_feet_z),
+                    violation(motion.feet_x, motion.feet_z));
+  };
   if (c.landing) {
-    const double d = std::max(0.0, std::fabs(motion.feet_x - c.landing_center) - c.landing_half_width);
-    quadratic("landing", d);
+    quadratic("landing", at_touchdown_and_rest([&](double x, double) {
+                return std::max(0.0, std::fabs(x - c.landing_center) - c.landing_half_width);
+              }));
   }
   if (c.on_box) {
     const SceneObject* box = task.find_object(c.on_box_object);
     const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;
-    const double dx = std::max({0.0, lo - motion.feet_x, motion.feet_x - hi});
-    // The foot centre sits one foot radius above the surface it stands on.
-    const double dz = std::max(0.0, box->height - motion.feet_z);
-    quadratic("on_box", std::hypot(dx, dz));
+    quadratic("on_box", at_touchdown_and_rest([&](double x, double z) {
+                const double dx = std::max({0.0, lo - x, x - hi});
+                // The foot centre sits one foot radius above the surface it stands on.
+                const double dz = std::max(0.0, box->height - z);
+                return std::hypot(dx, dz);
+              }));
   }
   if (c.clearance) {
     quadratic("clearance", std::max(0.0, c.min_clearance - motion.min_clearance));
   }
   if (c.min_length) {
-    quadratic("min_length", std::max(0.0, c.min_length_value - motion.feet_x));
+    quadratic("min_length", at_touchdown_and_rest([&](double x, double) {
+                return std::max(0.0, c.min_length_value - x);
+              }));
   }
   if (c.peak_height) {
     quadratic("peak_height", std::max(0.0, c.peak_height_min - motion.peak_com_z));
@@ -55,16 +65,16 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
 double constraint_margin(const Task& task, const MotionSummary& motion) {
   const TaskConstraints& c = task.constraints;
   double margin = 1.0;  // m; no constraint is looser than this counts
-  if (c.landing) {
-    margin = std::min(margin, c.landing_half_width - std::fabs(motion.feet_x - c.landing_center));
-  }
-  if (c.on_box) {
-    const SceneObject* box = task.find_object(c.on_box_object);
-    const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;
-    margin = std::min({margin, motion.feet_x - lo, hi - motion.feet_x});
+  for (const double x : {motion.touchdown_feet_x, motion.feet_x}) {
+    if (c.landing) margin = std::min(margin, c.landing_half_width - std::fabs(x - c.landing_center));
+    if (c.on_box) {
+      const SceneObject* box = task.find_object(c.on_box_object);
+      const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;
+      margin = std::min({margin, x - lo, hi - x});
+    }
+    if (c.min_length) margin = std::min(margin, x - c.min_length_value);
   }
   if (c.clearance) margin = std::min(margin, motion.min_clearance - c.min_clearance);
-  if (c.min_length) margin = std::min(margin, motion.feet_x - c.min_length_value);
   if (c.peak_height) margin = std::min(margin, motion.peak_com_z - c.peak_height_min);
   if (c.rotation) {
     const double miss = std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns);

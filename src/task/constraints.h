@@ -9,6 +9,12 @@
 // simulation blew up costs 3 * fall_penalty. The backflip's rotation requirement adds
 // rotation_penalty plus K_c d^2 when the root's rotation from start to end misses
 // turns * 2 pi by more than the tolerance.
+//
+// Where the character lands (the landing box, on_box, min_length) is checked twice: at
+// the first touch-down after flight and at rest, and the larger violation counts. The
+// jump itself has to cover the distance, and the feet have to stay where they came down:
+// a motion that touches down short and hops or slides the rest of the way does not land
+// in the box.
 #pragma once
 
 #include <string>
@@ -29,6 +35,7 @@ struct MotionSummary {
   double fall_progress = 1;   // how far the motion got before falling, in [0, 1]
   double peak_com_z = 0;      // m, highest whole-body COM during flight
   double feet_x = 0, feet_z = 0;   // m, mean of the foot centres at the end
+  double touchdown_feet_x = 0, touchdown_feet_z = 0;  // m, the same at the first touch-down
   double rotation_total = 0;  // rad, root pitch at the end minus at the start
   double rotation_flight = 0; // rad, root pitch at landing minus at take-off
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)

@@ -53,6 +53,8 @@ class JumpHooks : public StepHooks {
       if (!s.took_off || controller_.extend_timed_out()) return fall(t, "never left the ground", d);
       s.landed = true;
       s.rotation_flight = pitch - pitch_takeoff_;
+      s.touchdown_feet_x = feet_mean(d, 0);
+      s.touchdown_feet_z = feet_mean(d, 2);
     }
 
     // Obstacle proximity (contacts in the margin gap included).
@@ -102,6 +104,11 @@ class JumpHooks : public StepHooks {
     return static_cast<double>(std::min(phase, 5)) / static_cast<double>(kNumJumpPhases);
   }
 
+  // Mean over the two foot centres of world coordinate `axis` (0 = x, 2 = z).
+  double feet_mean(const mjData* d, int axis) const {
+    return 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + axis] + d->geom_xpos[3 * body_.foot_geom[1] + axis]);
+  }
+
   bool fall(double t, const char* why, const mjData* d) {
     MotionSummary& s = out_.summary;
     s.fell = true;
@@ -113,9 +120,12 @@ class JumpHooks : public StepHooks {
   bool finish(double t, const mjData* d) {
     MotionSummary& s = out_.summary;
     s.end_time = t;
-    s.feet_x = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0]] + d->geom_xpos[3 * body_.foot_geom[1]]);
-    s.feet_z = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + 2] +
-                      d->geom_xpos[3 * body_.foot_geom[1] + 2]);
+    s.feet_x = feet_mean(d, 0);
+    s.feet_z = feet_mean(d, 2);
+    if (!s.landed) {  // never touched down: the end position stands for both
+      s.touchdown_feet_x = s.feet_x;
+      s.touchdown_feet_z = s.feet_z;
+    }
     s.rotation_total = d->qpos[body_.root_pitch_qpos] - pitch0_;
     return true;
   }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -17,9 +18,6 @@ namespace {
 
 constexpr double kMarginCap = 0.1;  // m; slack beyond this earns nothing more
 constexpr int kPatience = 25;       // generations without improvement that end the last stage
-// An intermediate continuation stage moves on once a candidate meets its task and at
-// least this fraction of its perturbations do too (when perturbations are on).
-constexpr double kStageRobustness = 0.5;
 // Stream keys of the perturbation seeds (ASCII "seedrob" and "measrob").
 constexpr std::uint64_t kSeedPerturbations = 0x73656564726f62;
 constexpr std::uint64_t kMeasurePerturbations = 0x6d656173726f62;
@@ -82,9 +80,19 @@ double seed_constraint(const Evaluation& e, const Task& task, const SeedOptions&
   return c;
 }
 
+// How far apart the feet land (touch-down or rest, m) at the two timesteps beyond
+// kTimestepAgreement; 0 when either rollout has no landing to compare (a fall, which C
+// already penalizes).
+double landing_shift_excess(const Evaluation& coarse, const Evaluation& fine) {
+  if (coarse.failed || fine.failed || coarse.fell || fine.fell) return 0;
+  return std::max(0.0, landing_shift(coarse.summary, fine.summary) - kTimestepAgreement);
+}
+
 struct Scored {
   double f = 0;
-  double constraint = 0;  // C at the task's timestep plus C with it halved
+  // C at the task's timestep plus C with it halved, plus K_c d^2 for landing spots
+  // further apart than kTimestepAgreement by d.
+  double constraint = 0;
   double margin = 0;      // smallest constraint_margin of the two
   double met = 0;         // fraction of the perturbations with C = 0 (0 if none)
   bool fell = true;
@@ -92,8 +100,9 @@ struct Scored {
 };
 
 // Scores x on the task at its timestep and again with the timestep halved: a motion
-// counts as meeting the task only if it does so at both timesteps, which keeps input
-// motions away from knife-edge landings that depend on integration details. With
+// counts as meeting the task only if it does so at both timesteps, landing within
+// kTimestepAgreement of the same spot, which keeps input motions away from knife-edge
+// landings that depend on integration details. With
 // perturbations, x is also simulated at each x + sigma_r z_k, and f is the mean C over
 // all these rollouts: the expected penalty under small parameter changes, a smoothed
 // landscape on which CMA-ES moves towards regions where whole neighbourhoods meet the
@@ -108,7 +117,9 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
   const Evaluation e = ev.evaluate_normalized(x, worker, options);
   const Evaluation f = fine.evaluate_normalized(x, fine_worker, options);
   Scored s;
-  s.constraint = seed_constraint(e, ev.task(), seed) + seed_constraint(f, fine.task(), seed);
+  const double shift = landing_shift_excess(e, f);
+  s.constraint = seed_constraint(e, ev.task(), seed) + seed_constraint(f, fine.task(), seed) +
+                 ev.task().constraints.weight * shift * shift;
   s.fell = e.fell || f.fell;
   s.margin = std::min(e.failed ? -1 : constraint_margin(ev.task(), e.summary),
                       f.failed ? -1 : constraint_margin(fine.task(), f.summary));
@@ -172,16 +183,17 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       fine_workers.push_back(fine.make_worker());
     }
 
+    // Perturbations only in the last stage: an intermediate stage has to get over the
+    // raised object, which a mean over perturbations discourages (a neighbourhood that
+    // lands short of a box beats one that partly hits its face); the last stage then
+    // looks for a robust motion.
+    SeedOptions stage_options = options;
+    if (!last) stage_options.perturbations = 0;
     const int dim = static_cast<int>(x.size());
-    Robustness robust = generation_robustness(task, dim, options, stage, 0);
-    // Done with a stage: an intermediate one as soon as a candidate meets its task (with
-    // enough of its neighbourhood, when perturbations are on); the last one when the
-    // candidate with the lowest objective meets the task and nothing has improved for
-    // kPatience generations (or after the generation budget).
-    auto good_enough = [&](const Scored& v) {
-      return v.meets() && (robust.directions.empty() || v.met >= kStageRobustness);
-    };
-
+    Robustness robust = generation_robustness(task, dim, stage_options, stage, 0);
+    // Done with a stage: an intermediate one as soon as a candidate meets its task; the
+    // last one when the candidate with the lowest objective meets the task and nothing
+    // has improved for kPatience generations (or after the generation budget).
     Scored best = score(ev, fine, x, *workers[0], *fine_workers[0], robust, options);
     Eigen::VectorXd best_x = x;
     bool have_valid = best.meets();
@@ -200,7 +212,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       result.lowest_mean_f = best.f;
       result.lowest_mean_meets = best.meets();
     }
-    if (!last && good_enough(best)) continue;
+    if (!last && best.meets()) continue;
 
     CmaesOptions co;
     co.dim = static_cast<int>(x.size());
@@ -215,7 +227,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     int since_improvement = 0;
     while (es.stop_reason() == StopReason::kNone) {
       const std::vector<Eigen::VectorXd>& xs = es.ask();
-      robust = generation_robustness(task, dim, options, stage, es.generation() + 1);
+      robust = generation_robustness(task, dim, stage_options, stage, es.generation() + 1);
       std::vector<Scored> scores(xs.size());
       pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
         const auto w = static_cast<std::size_t>(worker);
@@ -253,7 +265,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
                       have_valid ? "" : " (none meets the task yet)", best.f, median, es.sigma());
         options.log(line);
       }
-      if (!last && have_valid && good_enough(best_valid)) break;
+      if (!last && have_valid) break;
       if (last && best.meets() && since_improvement >= kPatience) break;
     }
     x = have_valid ? best_valid_x : best_x;
@@ -282,6 +294,10 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   return result;
 }
 
+double landing_shift(const MotionSummary& a, const MotionSummary& b) {
+  return std::max(std::fabs(a.touchdown_feet_x - b.touchdown_feet_x), std::fabs(a.feet_x - b.feet_x));
+}
+
 std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,
                                      std::uint64_t seed) {
   std::vector<Eigen::VectorXd> out;
@@ -302,9 +318,14 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
   options.samples_per_phase = 0;
   RobustnessReport report;
   const Eigen::VectorXd x = parameters.normalized();
-  report.constraint = ev.evaluate_normalized(x, *workers[0], options).constraint;
+  const Evaluation coarse = ev.evaluate_normalized(x, *workers[0], options);
   auto fine_worker = fine.make_worker();
-  report.constraint_fine = fine.evaluate_normalized(x, *fine_worker, options).constraint;
+  const Evaluation fine_e = fine.evaluate_normalized(x, *fine_worker, options);
+  report.constraint = coarse.constraint;
+  report.constraint_fine = fine_e.constraint;
+  report.landing_shift = coarse.fell || fine_e.fell || coarse.failed || fine_e.failed
+                             ? std::numeric_limits<double>::quiet_NaN()
+                             : landing_shift(coarse.summary, fine_e.summary);
   for (size_t level = 0; level < sigmas.size(); ++level) {
     const std::vector<Eigen::VectorXd> xs =
         perturb(x, sigmas[level], samples,

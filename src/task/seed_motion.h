@@ -4,10 +4,12 @@
 // the task's constraint penalty C, as the paper does for each jump. With continuation
 // (Jump onto, Jump over), the scene object's height is raised in stages, each stage
 // starting from the previous stage's best; intermediate stages stop as soon as a
-// candidate meets the stage's task (with half of its perturbations, when those are on).
+// candidate meets the stage's task.
 //
 // Objective: every candidate is simulated at the task's timestep and with it halved, and
-// counts as meeting the task only if it does so at both, so input motions do not hinge
+// counts as meeting the task only if it does so at both and its feet land (at touch-down
+// and at rest) within kTimestepAgreement of the same spot at both (landing d further
+// apart adds K_c d^2), so input motions do not hinge
 // on integration details. f is the mean C of these rollouts; when all of them meet the
 // task, f = -robustness * min(margin, 0.1 m), where margin is the smallest slack inside
 // the allowed region (task/constraints.h, constraint_margin): a small reward for slack
@@ -16,16 +18,19 @@
 //
 // Robustness (ours): the diversity optimizer starts from M0 and samples around it, so an
 // input motion is only useful if some of its neighbourhood also meets the task. With
-// SeedOptions::perturbations = P > 0, every candidate is also simulated at P
-// perturbations x + sigma_r z_k of its normalized parameters (reflected into [0, 1] as
-// the optimizer's samples are; the same directions z_k for every candidate of a
-// generation, so candidates are ranked on equal terms, and fresh ones in every
-// generation, so the search cannot tune a motion to a few fixed directions), and the
-// objective is the mean C over the 2 + P rollouts: the expected penalty under small
-// parameter changes. The result is the best candidate that meets the task at both
-// timesteps (ranked by that mean), so a neighbourhood that meets the task is preferred
-// to a lucky point. measure_robustness() reports the fraction of another set of
-// perturbations that meet the task.
+// SeedOptions::perturbations = P > 0, every candidate of the last stage (the task
+// itself) is also simulated at P perturbations x + sigma_r z_k of its normalized
+// parameters (reflected into [0, 1] as the optimizer's samples are; the same directions
+// z_k for every candidate of a generation, so candidates are ranked on equal terms, and
+// fresh ones in every generation, so the search cannot tune a motion to a few fixed
+// directions), and the objective is the mean C over the 2 + P rollouts: the expected
+// penalty under small parameter changes. The result is the best candidate that meets
+// the task at both timesteps (ranked by that mean), so a neighbourhood that meets the
+// task is preferred to a lucky point. Intermediate continuation stages go without: they
+// have to get over the raised object, which a mean over perturbations discourages (a
+// neighbourhood that lands short of a box beats one that partly hits its face).
+// measure_robustness() reports the fraction of another set of perturbations that meet
+// the task.
 //
 // Deterministic for a given task seed: CMA-ES draws from seeds derived from it, the
 // perturbations likewise, and the generation's samples are evaluated in parallel into
@@ -39,9 +44,18 @@
 #include <vector>
 
 #include "control/parameters.h"
+#include "task/constraints.h"
 #include "task/task.h"
 
 namespace diverse {
+
+// The landing spots of an input motion at the task's timestep and at half of it differ
+// by at most this much (m).
+constexpr double kTimestepAgreement = 0.03;
+
+// The larger of the horizontal distances between a's and b's feet at touch-down and at
+// rest (m).
+double landing_shift(const MotionSummary& a, const MotionSummary& b);
 
 struct SeedOptions {
   int threads = 1;
@@ -90,6 +104,7 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
 struct RobustnessReport {
   double constraint = 0;       // C at the task's timestep
   double constraint_fine = 0;  // C with the timestep halved
+  double landing_shift = 0;    // landing_shift() between the two (m; NaN if either fell)
   struct Level {
     double sigma = 0;  // normalized
     int samples = 0;

@@ -33,7 +33,9 @@ struct SceneObject {
 struct TaskConstraints {
   double weight = 5000;           // K_c in C = K_c |d|^2 (SPEC 2.4)
   double fall_penalty = 100000;   // constant for a fall (doubles for the earliest falls)
-  // Landing box: feet (mean of the two foot centres) end within center +- half_width (x).
+  // The landing constraints (landing, on_box, min_length) hold for the feet at the first
+  // touch-down after flight and at rest (see task/constraints.h).
+  // Landing box: feet (mean of the two foot centres) within center +- half_width (x).
   bool landing = false;
   double landing_center = 0, landing_half_width = 0.15;  // m
   // On top of a box object, at least `on_box_margin` from its edges.
@@ -44,7 +46,7 @@ struct TaskConstraints {
   bool clearance = false;
   std::string clearance_object;
   double min_clearance = 0;  // m
-  // Minimum jump length: feet end at x >= min_length.
+  // Minimum jump length: feet at x >= min_length.
   bool min_length = false;
   double min_length_value = 0;  // m
   // Minimum peak height of the whole-body COM.

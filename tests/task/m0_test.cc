@@ -93,7 +93,9 @@ TEST_P(M0, TimestepHalvedLandsNearby) {
   REQUIRE_M0(GetParam());
   const SimRun a = simulate(GetParam());
   const SimRun b = simulate(GetParam(), 0.001);
-  EXPECT_NEAR(a.e.summary.feet_x, b.e.summary.feet_x, 0.05) << GetParam();
+  // Both where the feet touch down and where they come to rest (landing_shift); input
+  // motions are searched for within kTimestepAgreement (3 cm), the bound here is 5 cm.
+  EXPECT_LT(landing_shift(a.e.summary, b.e.summary), 0.05) << GetParam();
   EXPECT_FALSE(b.e.fell) << b.e.summary.fall_reason;
 }
 
@@ -137,6 +139,19 @@ TEST(M0Specifics, JumpOntoStandsOnTheBox) {
   EXPECT_GT(r.e.summary.feet_x, box->x_min + 0.1);
   EXPECT_LT(r.e.summary.feet_x, box->x_max - 0.1);
   EXPECT_GT(r.e.summary.feet_z, box->height);  // standing on top, not beside it
+  // and it came down there: feet on top of the box at the first touch-down
+  EXPECT_GT(r.e.summary.touchdown_feet_x, box->x_min + 0.1);
+  EXPECT_LT(r.e.summary.touchdown_feet_x, box->x_max - 0.1);
+  EXPECT_GT(r.e.summary.touchdown_feet_z, box->height);
+}
+
+// The jump covers the distance in the air: the feet touch down in the landing box and
+// stay within it (no short landing followed by a hop or a slide).
+TEST(M0Specifics, JumpForwardTouchesDownInTheBox) {
+  REQUIRE_M0("jump_forward");
+  const SimRun r = simulate("jump_forward");
+  EXPECT_NEAR(r.e.summary.touchdown_feet_x, 1.0, 0.15);
+  EXPECT_NEAR(r.e.summary.feet_x, 1.0, 0.15);
 }
 
 TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
@@ -144,6 +159,7 @@ TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
   const SimRun r = simulate("jump_over");
   EXPECT_GE(r.e.summary.min_clearance, 0.02);
   EXPECT_GE(r.e.summary.feet_x, 1.0);
+  EXPECT_GE(r.e.summary.touchdown_feet_x, 1.0);
 }
 
 TEST(M0Specifics, JumpHighPeaksHighEnough) {

@@ -45,6 +45,8 @@ TEST(SeedMotionCli, RobustnessCheckReportsBothTimestepsAndTheNeighbourhood) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("C = 0 at the task's timestep, 0 with it halved"), std::string::npos)
       << r.output;
+  EXPECT_NE(r.output.find("landing spots at the two timesteps differ by 0.0"), std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("sigma 0.000: 3 of 3 perturbations meet the task (100 %)"),
             std::string::npos)
       << r.output;

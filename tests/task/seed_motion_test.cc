@@ -102,5 +102,40 @@ TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(one.evaluations, 4 * (1 + task.seed.popsize));
 }
 
+// The landing spot is where the feet touch down and where they rest, whichever moved more.
+TEST(SeedMotion, LandingShiftIsTheLargerOfTouchdownAndRest) {
+  MotionSummary a, b;
+  a.touchdown_feet_x = 1.00;
+  b.touchdown_feet_x = 0.98;
+  a.feet_x = 1.10;
+  b.feet_x = 1.15;
+  EXPECT_NEAR(landing_shift(a, b), 0.05, 1e-12);
+  EXPECT_NEAR(landing_shift(b, a), 0.05, 1e-12);
+  b.touchdown_feet_x = 0.9;
+  EXPECT_NEAR(landing_shift(a, b), 0.10, 1e-12);
+  EXPECT_EQ(landing_shift(a, a), 0.0);
+}
+
+// jump_high's M0 meets its task at both timesteps, but lands 4 cm apart at the two (more
+// than the 3 cm an input motion is searched for within): to the search it is not yet
+// an input motion, and neither is any candidate of one generation close around it.
+TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const RobustnessReport check = measure_robustness(task, m0, {}, 0, 1);
+  EXPECT_EQ(check.constraint, 0.0);
+  EXPECT_EQ(check.constraint_fine, 0.0);
+  EXPECT_GT(check.landing_shift, kTimestepAgreement);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.sigma = 1e-6;  // candidates barely different from M0
+  const SeedResult r = seed_motion(task, m0, options);
+  const double d = check.landing_shift - kTimestepAgreement;
+  EXPECT_GT(r.constraint, 0.0);  // M0's K_c d^2 or a candidate's smaller one, never 0
+  EXPECT_LE(r.constraint, task.constraints.weight * d * d + 1e-12);
+}
+
 }  // namespace
 }  // namespace diverse

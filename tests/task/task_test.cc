@@ -171,10 +171,10 @@ TEST(Constraints, PenaltiesFollowSpec) {
   MotionSummary m;
   m.took_off = m.landed = m.settled = true;
   m.fell = false;
-  m.feet_x = 1.0;
+  m.feet_x = m.touchdown_feet_x = 1.0;
   ConstraintReport r = evaluate_constraints(t, m);
   EXPECT_EQ(r.total, 0.0);
-  m.feet_x = 1.0 + 0.15 + 0.1;  // 10 cm outside the box
+  m.feet_x = m.touchdown_feet_x = 1.0 + 0.15 + 0.1;  // 10 cm outside the box
   r = evaluate_constraints(t, m);
   EXPECT_NEAR(r.total, 5000 * 0.1 * 0.1, 1e-9);
   m.fell = true;
@@ -189,12 +189,49 @@ TEST(Constraints, PenaltiesFollowSpec) {
 
   Task flip = load_task(kTasks + "backflip.toml");
   MotionSummary f;
-  f.feet_x = flip.constraints.landing_center;
+  f.feet_x = f.touchdown_feet_x = flip.constraints.landing_center;
   f.rotation_total = 2 * M_PI - 0.4;  // within the 0.5 rad tolerance
   EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
   f.rotation_total = 2 * M_PI - 0.7;  // 0.2 rad beyond it
   EXPECT_NEAR(evaluate_constraints(flip, f).total, 100000 + 5000 * 0.04, 1e-6);
   EXPECT_GT(constraint_margin(flip, MotionSummary{}), -2);  // defined everywhere
+}
+
+// Where the feet come down counts as much as where they come to rest: touching down
+// short of the box and hopping or sliding into it violates the landing constraint.
+TEST(Constraints, LandingIsMeasuredAtTouchdownAndAtRest) {
+  Task t = load_task(kTasks + "jump_forward.toml");
+  MotionSummary m;
+  m.took_off = m.landed = m.settled = true;
+  m.touchdown_feet_x = 0.6;  // 25 cm short of the box at touch-down
+  m.feet_x = 1.0;            // in its centre at rest
+  ConstraintReport r = evaluate_constraints(t, m);
+  EXPECT_NEAR(r.total, 5000 * 0.25 * 0.25, 1e-9);
+  EXPECT_NEAR(constraint_margin(t, m), -0.25, 1e-12);
+  m.touchdown_feet_x = 1.0;  // came down in the centre, slid 20 cm past the box
+  m.feet_x = 1.35;
+  EXPECT_NEAR(evaluate_constraints(t, m).total, 5000 * 0.2 * 0.2, 1e-9);
+
+  // Jump onto: touching down on the box's face (below its top) is not standing on it.
+  Task onto = load_task(kTasks + "jump_onto.toml");
+  const SceneObject* box = onto.find_object("box");
+  MotionSummary b;
+  b.took_off = b.landed = b.settled = true;
+  b.feet_x = b.touchdown_feet_x = 0.5 * (box->x_min + box->x_max);
+  b.feet_z = box->height + 0.05;
+  b.touchdown_feet_z = box->height - 0.1;
+  EXPECT_NEAR(evaluate_constraints(onto, b).total, 5000 * 0.1 * 0.1, 1e-9);
+  b.touchdown_feet_z = b.feet_z;
+  EXPECT_EQ(evaluate_constraints(onto, b).total, 0.0);
+
+  // Jump over: the length counts where the feet came down.
+  Task over = load_task(kTasks + "jump_over.toml");
+  MotionSummary o;
+  o.took_off = o.landed = o.settled = true;
+  o.min_clearance = 0.5;
+  o.touchdown_feet_x = 0.9;
+  o.feet_x = 1.2;
+  EXPECT_NEAR(evaluate_constraints(over, o).total, 5000 * 0.1 * 0.1, 1e-9);
 }
 
 }  // namespace
