@@ -116,13 +116,15 @@ TEST(SeedMotion, LandingShiftIsTheLargerOfTouchdownAndRest) {
   EXPECT_EQ(landing_shift(a, a), 0.0);
 }
 
-// jump_high's M0 meets its task at both timesteps, but lands 4 cm apart at the two (more
-// than the 3 cm an input motion is searched for within): to the search it is not yet
-// an input motion, and neither is any candidate of one generation close around it.
+// An earlier jump_high input motion meets its task at both timesteps, but lands 4 cm
+// apart at the two (more than the 3 cm an input motion is searched for within): to the
+// search it is not yet an input motion, and neither is any candidate of one generation
+// close around it.
 TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
   const Task task = load_task(kTasks + "jump_high.toml");
   const TaskEvaluator ev(task);
-  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const ParameterSet m0 = ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) +
+                                             "/tests/task/data/jump_high_lands_apart.json");
   const RobustnessReport check = measure_robustness(task, m0, {}, 0, 1);
   EXPECT_EQ(check.constraint, 0.0);
   EXPECT_EQ(check.constraint_fine, 0.0);
