@@ -92,7 +92,10 @@ void run(const SeedArgs& args) {
                  ? m0_path.substr(0, m0_path.size() - 5)
                  : m0_path);
   const std::string partial_path = stem + ".partial.json";
-  std::string command = "diverse seed-motion " + task.name + " --start " + start_path;
+  // The command as the user gave it: --start only when it was given (the task's [seed]
+  // base otherwise, named relative to the task file).
+  std::string command = "diverse seed-motion " + task.name;
+  if (!args.start.empty()) command += " --start " + args.start;
   if (args.generations > 0) command += " --generations " + std::to_string(args.generations);
   if (args.sigma > 0) {
     char sigma[32];
