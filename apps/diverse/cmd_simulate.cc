@@ -60,7 +60,11 @@ void run(const SimulateArgs& args) {
               e.fell ? e.summary.fall_reason.c_str() : "");
   if (e.failed) std::printf("failed: %s\n", e.failure.c_str());
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    std::printf("  phase %-7s begins at %.3f s\n", jump_phase_name(p), e.phases.begin[p]);
+    if (e.phases.begin[p] < 0) {
+      std::printf("  phase %-7s not reached\n", jump_phase_name(p));
+    } else {
+      std::printf("  phase %-7s begins at %.3f s\n", jump_phase_name(p), e.phases.begin[p]);
+    }
   }
   const MotionSummary& s = e.summary;
   std::printf("peak COM %.3f m, feet touch down at x %.3f m z %.3f m and end at x %.3f m z %.3f m, "
