@@ -2,15 +2,39 @@
 # Paper section 9: round-robin against progressive addition on the backflip, N = 4,
 # five seeds each; prints Dmin, mean and Dmax of both beside the paper's figures.
 #   scripts/compare-strategies.sh [GENERATIONS] [OUT]
+# The ten runs take about 70 minutes at 500 generations on a 2-core machine. The script
+# can be stopped at any moment and started again with the same arguments: a finished
+# run with the same settings is kept, an interrupted one continues from its checkpoint
+# (`diverse resume`, same result as uninterrupted), anything else is run afresh.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 generations="${1:-500}"
 out="${2:-$here/runs/section9}"
 diverse="$here/build/diverse"
+[ -x "$diverse" ] || { echo "compare-strategies.sh: $diverse is not built (scripts/build.sh)" >&2; exit 2; }
+command -v jq >/dev/null || { echo "compare-strategies.sh: needs jq (scripts/setup.sh installs it)" >&2; exit 2; }
+
+# Does DIR hold a run of this comparison (strategy, seed, generations)?
+same_run() {
+  [ -f "$1/run.json" ] &&
+    jq -e --arg s "$2" --argjson seed "$3" --argjson g "$generations" \
+      '.options.strategy == $s and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4' \
+      "$1/run.json" >/dev/null 2>&1
+}
+
 for strategy in round-robin progressive; do
   for seed in 1 2 3 4 5; do
-    "$diverse" run backflip --n 4 --generations "$generations" --strategy "$strategy" \
-      --seed "$seed" --out "$out/$strategy-$seed" --force --quiet
+    dir="$out/$strategy-$seed"
+    if same_run "$dir" "$strategy" "$seed" && [ -f "$dir/summary.json" ]; then
+      echo "$strategy seed $seed: finished earlier, kept"
+    elif same_run "$dir" "$strategy" "$seed" && [ -f "$dir/checkpoint.json" ]; then
+      echo "$strategy seed $seed: resuming"
+      "$diverse" resume "$dir" --quiet
+    else
+      echo "$strategy seed $seed: running"
+      "$diverse" run backflip --n 4 --generations "$generations" --strategy "$strategy" \
+        --seed "$seed" --out "$dir" --force --quiet
+    fi
   done
 done
 "$diverse" report "$out"/round-robin-* "$out"/progressive-* | tee "$out/table.md"
