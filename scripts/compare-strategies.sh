@@ -2,6 +2,7 @@
 # Paper section 9: round-robin against progressive addition on the backflip, N = 4,
 # five seeds each; prints Dmin, mean and Dmax of both beside the paper's figures.
 #   scripts/compare-strategies.sh [GENERATIONS] [OUT]
+# (DIVERSE=path picks the `diverse` binary; default build/diverse.)
 # The ten runs take about 70 minutes at 500 generations on a 2-core machine. The script
 # can be stopped at any moment and started again with the same arguments: a finished
 # run with the same settings is kept, an interrupted one continues from its checkpoint
@@ -10,7 +11,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 generations="${1:-500}"
 out="${2:-$here/runs/section9}"
-diverse="$here/build/diverse"
+diverse="${DIVERSE:-$here/build/diverse}"
 [ -x "$diverse" ] || { echo "compare-strategies.sh: $diverse is not built (scripts/build.sh)" >&2; exit 2; }
 command -v jq >/dev/null || { echo "compare-strategies.sh: needs jq (scripts/setup.sh installs it)" >&2; exit 2; }
 

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# scripts/compare-strategies.sh end to end at 2 generations per run: the ten runs and
+# the table; started again, it keeps the finished runs and resumes an interrupted one
+# (its summary removed, its checkpoint kept) to the same table.
+#
+#   compare_strategies_e2e.sh DIVERSE_BINARY SOURCE_DIR
+set -euo pipefail
+diverse="$1"
+src="$2"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAILED: $*"; exit 1; }
+
+DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 2 "$work/out" > "$work/first.txt"
+[ "$(grep -c ': running$' "$work/first.txt")" = 10 ] || fail "expected 10 fresh runs: $(cat "$work/first.txt")"
+grep -q '^ours:  round-robin  Dmin .* (5 runs)$' "$work/first.txt" || fail "no round-robin line"
+grep -q '^ours:  progressive  Dmin .* (5 runs)$' "$work/first.txt" || fail "no progressive line"
+cp "$work/out/table.md" "$work/table-first.md"
+
+rm "$work/out/progressive-3/summary.json"
+DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 2 "$work/out" > "$work/second.txt"
+[ "$(grep -c ': finished earlier, kept$' "$work/second.txt")" = 9 ] || fail "expected 9 kept runs: $(cat "$work/second.txt")"
+grep -q '^progressive seed 3: resuming$' "$work/second.txt" || fail "progressive seed 3 was not resumed"
+# The same figures (the minutes column may differ).
+cut -d'|' -f2-7,9- "$work/table-first.md" > "$work/a"
+cut -d'|' -f2-7,9- "$work/out/table.md" > "$work/b"
+diff "$work/a" "$work/b" || fail "the table changed after resuming"
+
+# Another budget is another experiment: runs of 2 generations are not kept for 3.
+DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 3 "$work/out" > "$work/third.txt"
+[ "$(grep -c ': running$' "$work/third.txt")" = 10 ] || fail "expected 10 fresh runs at 3 generations"
+echo "compare-strategies.sh: fresh, kept, resumed and re-run as expected"
