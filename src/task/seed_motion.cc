@@ -80,11 +80,16 @@ double seed_constraint(const Evaluation& e, const Task& task, const SeedOptions&
   return c;
 }
 
+// Both rollouts landed and came to rest, so their landing spots can be compared.
+bool both_landed(const Evaluation& coarse, const Evaluation& fine) {
+  return !(coarse.failed || fine.failed || coarse.fell || fine.fell);
+}
+
 // How far apart the feet land (touch-down or rest, m) at the two timesteps beyond
 // kTimestepAgreement; 0 when either rollout has no landing to compare (a fall, which C
 // already penalizes).
 double landing_shift_excess(const Evaluation& coarse, const Evaluation& fine) {
-  if (coarse.failed || fine.failed || coarse.fell || fine.fell) return 0;
+  if (!both_landed(coarse, fine)) return 0;
   return std::max(0.0, landing_shift(coarse.summary, fine.summary) - kTimestepAgreement);
 }
 
@@ -323,9 +328,8 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
   const Evaluation fine_e = fine.evaluate_normalized(x, *fine_worker, options);
   report.constraint = coarse.constraint;
   report.constraint_fine = fine_e.constraint;
-  report.landing_shift = coarse.fell || fine_e.fell || coarse.failed || fine_e.failed
-                             ? std::numeric_limits<double>::quiet_NaN()
-                             : landing_shift(coarse.summary, fine_e.summary);
+  report.landing_shift = both_landed(coarse, fine_e) ? landing_shift(coarse.summary, fine_e.summary)
+                                                     : std::numeric_limits<double>::quiet_NaN();
   for (size_t level = 0; level < sigmas.size(); ++level) {
     const std::vector<Eigen::VectorXd> xs =
         perturb(x, sigmas[level], samples,
