@@ -23,9 +23,11 @@ same_run() {
       "$1/run.json" >/dev/null 2>&1
 }
 
+runs=()
 for strategy in round-robin progressive; do
   for seed in 1 2 3 4 5; do
     dir="$out/$strategy-$seed"
+    runs+=("$dir")
     if same_run "$dir" "$strategy" "$seed" && [ -f "$dir/summary.json" ]; then
       echo "$strategy seed $seed: finished earlier, kept"
     elif same_run "$dir" "$strategy" "$seed" && [ -f "$dir/checkpoint.json" ]; then
@@ -38,7 +40,7 @@ for strategy in round-robin progressive; do
     fi
   done
 done
-"$diverse" report "$out"/round-robin-* "$out"/progressive-* | tee "$out/table.md"
+"$diverse" report "${runs[@]}" | tee "$out/table.md"
 echo
 echo "paper: progressive Dmin 41.8, mean 54.4, Dmax 64.1; round-robin 71.2 / 83.5 / 103.7"
 for strategy in round-robin progressive; do

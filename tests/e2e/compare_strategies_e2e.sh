@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # scripts/compare-strategies.sh end to end at 2 generations per run: the ten runs and
 # the table; started again, it keeps the finished runs and resumes an interrupted one
-# (its summary removed, its checkpoint kept) to the same table.
+# (its summary removed, its checkpoint kept) to the same table, whatever else the output
+# folder holds.
 #
 #   compare_strategies_e2e.sh DIVERSE_BINARY SOURCE_DIR
 set -euo pipefail
@@ -18,6 +19,8 @@ grep -q '^ours:  progressive  Dmin .* (5 runs)$' "$work/first.txt" || fail "no p
 cp "$work/out/table.md" "$work/table-first.md"
 
 rm "$work/out/progressive-3/summary.json"
+# Other files beside the run directories (a log kept next to them) are not runs.
+echo "log" > "$work/out/round-robin-1.log"
 DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 2 "$work/out" > "$work/second.txt"
 [ "$(grep -c ': finished earlier, kept$' "$work/second.txt")" = 9 ] || fail "expected 9 kept runs: $(cat "$work/second.txt")"
 grep -q '^progressive seed 3: resuming$' "$work/second.txt" || fail "progressive seed 3 was not resumed"
