@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Paper section 9: round-robin against progressive addition on the backflip, N = 4,
 # five seeds each; prints Dmin, mean and Dmax of both beside the paper's figures.
-#   scripts/compare-strategies.sh [GENERATIONS] [OUT]
+#   scripts/compare-strategies.sh [GENERATIONS] [OUT] [VARIANT]
+# VARIANT is `ours` (default: violating samples rank below feasible ones, a variation
+# stands at its best sample) or `paper` (eq. 1 literally: --constraints penalty --point
+# mean, as the paper prints it).
 # (DIVERSE=path picks the `diverse` binary; default build/diverse.)
 # The ten runs take about 70 minutes at 500 generations on a 2-core machine. The script
 # can be stopped at any moment and started again with the same arguments: a finished
@@ -11,15 +14,22 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 generations="${1:-500}"
 out="${2:-$here/runs/section9}"
+variant="${3:-ours}"
 diverse="${DIVERSE:-$here/build/diverse}"
+case "$variant" in
+  ours) constraints=dominant point=best-sample ;;
+  paper) constraints=penalty point=mean ;;
+  *) echo "compare-strategies.sh: VARIANT: expected ours or paper, got '$variant'" >&2; exit 2 ;;
+esac
 [ -x "$diverse" ] || { echo "compare-strategies.sh: $diverse is not built (scripts/build.sh)" >&2; exit 2; }
 command -v jq >/dev/null || { echo "compare-strategies.sh: needs jq (scripts/setup.sh installs it)" >&2; exit 2; }
 
-# Does DIR hold a run of this comparison (strategy, seed, generations)?
+# Does DIR hold a run of this comparison (strategy, seed, generations, variant)?
 same_run() {
   [ -f "$1/run.json" ] &&
     jq -e --arg s "$2" --argjson seed "$3" --argjson g "$generations" \
-      '.options.strategy == $s and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4' \
+      --arg c "$constraints" --arg p "$point" \
+      '.options.strategy == $s and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4 and .options.constraints == $c and .options.point == $p' \
       "$1/run.json" >/dev/null 2>&1
 }
 
@@ -36,7 +46,7 @@ for strategy in round-robin progressive; do
     else
       echo "$strategy seed $seed: running"
       "$diverse" run backflip --n 4 --generations "$generations" --strategy "$strategy" \
-        --seed "$seed" --out "$dir" --force --quiet
+        --seed "$seed" --constraints "$constraints" --point "$point" --out "$dir" --force --quiet
     fi
   done
 done

@@ -2,7 +2,7 @@
 # scripts/compare-strategies.sh end to end at 2 generations per run: the ten runs and
 # the table; started again, it keeps the finished runs and resumes an interrupted one
 # (its summary removed, its checkpoint kept) to the same table, whatever else the output
-# folder holds.
+# folder holds; another budget or the paper's variant of the optimizer runs afresh.
 #
 #   compare_strategies_e2e.sh DIVERSE_BINARY SOURCE_DIR
 set -euo pipefail
@@ -32,4 +32,13 @@ diff "$work/a" "$work/b" || fail "the table changed after resuming"
 # Another budget is another experiment: runs of 2 generations are not kept for 3.
 DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 3 "$work/out" > "$work/third.txt"
 [ "$(grep -c ': running$' "$work/third.txt")" = 10 ] || fail "expected 10 fresh runs at 3 generations"
+# So is the paper's variant of the optimizer: every run again, with its options.
+DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 3 "$work/out" paper > "$work/fourth.txt"
+[ "$(grep -c ': running$' "$work/fourth.txt")" = 10 ] || fail "expected 10 fresh runs for the paper variant"
+jq -e '.options.constraints == "penalty" and .options.point == "mean"' "$work/out/progressive-2/run.json" >/dev/null ||
+  fail "the paper variant did not run with --constraints penalty --point mean"
+if DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 3 "$work/out" literal 2> "$work/err.txt"; then
+  fail "an unknown variant was accepted"
+fi
+grep -q "VARIANT: expected ours or paper, got 'literal'" "$work/err.txt" || fail "unclear error: $(cat "$work/err.txt")"
 echo "compare-strategies.sh: fresh, kept, resumed and re-run as expected"
