@@ -8,108 +8,11 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "core/toml_reader.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
 namespace {
-
-std::string num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
-// Strict reader of one TOML table; `path` is the dotted name used in messages.
-class Reader {
- public:
-  Reader(std::string file, const toml::table& table, std::string path)
-      : file_(std::move(file)), table_(table), path_(std::move(path)) {}
-
-  // Rejects keys not in `known`.
-  void only(std::initializer_list<const char*> known) const {
-    for (const auto& [key, node] : table_) {
-      bool ok = false;
-      for (const char* k : known) ok = ok || key.str() == k;
-      if (!ok) {
-        std::string list;
-        for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
-        fail(std::string(key.str()), "expected no such key (unknown key; known keys: " + list + ")");
-      }
-    }
-  }
-  bool has(const char* key) const { return table_.contains(key); }
-
-  [[noreturn]] void fail(const std::string& key, const std::string& expectation) const {
-    throw_field_error(file_, field(key), expectation);
-  }
-  std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  double number(const char* key, double lo, double hi) const {
-    const toml::node* n = table_.get(key);
-    const std::string expect = "expected a number in [" + num(lo) + ", " + num(hi) + "]";
-    if (n == nullptr) fail(key, expect + " (missing)");
-    double v = 0;
-    if (auto f = n->as_floating_point()) {
-      v = f->get();
-    } else if (auto i = n->as_integer()) {
-      v = static_cast<double>(i->get());
-    } else {
-      fail(key, expect);
-    }
-    if (!std::isfinite(v) || v < lo || v > hi) fail(key, expect + ", got " + num(v));
-    return v;
-  }
-  double number(const char* key, double lo, double hi, double fallback) const {
-    return has(key) ? number(key, lo, hi) : fallback;
-  }
-  long long integer(const char* key, long long lo, long long hi) const {
-    const toml::node* n = table_.get(key);
-    const std::string expect =
-        "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-    if (n == nullptr) fail(key, expect + " (missing)");
-    auto i = n->as_integer();
-    if (!i) fail(key, expect);
-    const long long v = i->get();
-    if (v < lo || v > hi) fail(key, expect + ", got " + std::to_string(v));
-    return v;
-  }
-  long long integer(const char* key, long long lo, long long hi, long long fallback) const {
-    return has(key) ? integer(key, lo, hi) : fallback;
-  }
-  std::string string(const char* key) const {
-    const toml::node* n = table_.get(key);
-    if (n == nullptr) fail(key, "expected a string (missing)");
-    auto s = n->as_string();
-    if (!s) fail(key, "expected a string");
-    return s->get();
-  }
-  std::string string(const char* key, const std::string& fallback) const {
-    return has(key) ? string(key) : fallback;
-  }
-  bool boolean(const char* key, bool fallback) const {
-    if (!has(key)) return fallback;
-    auto b = table_.get(key)->as_boolean();
-    if (!b) fail(key, "expected true or false");
-    return b->get();
-  }
-  const toml::table* table(const char* key, bool required) const {
-    const toml::node* n = table_.get(key);
-    if (n == nullptr) {
-      if (required) fail(key, "expected a table (missing)");
-      return nullptr;
-    }
-    if (!n->is_table()) fail(key, "expected a table");
-    return n->as_table();
-  }
-  Reader sub(const char* key, const toml::table& t) const { return Reader(file_, t, field(key)); }
-  const toml::table& raw() const { return table_; }
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  const toml::table& table_;
-  std::string path_;
-};
 
 std::string resolve(const std::string& task_file, const std::string& relative) {
   fs::path p(relative);
@@ -117,7 +20,7 @@ std::string resolve(const std::string& task_file, const std::string& relative) {
   return (fs::path(task_file).parent_path() / p).lexically_normal().string();
 }
 
-std::string existing_file(const Reader& r, const char* key) {
+std::string existing_file(const TomlReader& r, const char* key) {
   const std::string path = resolve(r.file(), r.string(key));
   if (!fs::is_regular_file(path)) {
     r.fail(key, "expected an existing file (relative to the task file), but " + path +
@@ -126,7 +29,7 @@ std::string existing_file(const Reader& r, const char* key) {
   return path;
 }
 
-void read_controller(const Reader& r, Task& task) {
+void read_controller(const TomlReader& r, Task& task) {
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation"});
   task.controller = r.string("type");
@@ -141,7 +44,7 @@ void read_controller(const Reader& r, Task& task) {
   c.gravity_compensation = r.number("gravity_compensation", 0, 2, c.gravity_compensation);
 }
 
-void read_objects(const Reader& r, const toml::node* node, Task& task) {
+void read_objects(const TomlReader& r, const toml::node* node, Task& task) {
   if (node == nullptr) return;
   const toml::array* list = node->as_array();
   if (list == nullptr) r.fail("objects", "expected an array of tables ([[objects]])");
@@ -149,7 +52,7 @@ void read_objects(const Reader& r, const toml::node* node, Task& task) {
     const std::string where = "objects[" + std::to_string(i) + "]";
     const toml::table* t = list->get(i)->as_table();
     if (t == nullptr) r.fail(where, "expected a table");
-    Reader o(r.file(), *t, where);
+    TomlReader o(r.file(), *t, where);
     o.only({"name", "kind", "x_min", "x_max", "height"});
     SceneObject obj;
     obj.name = o.string("name");
@@ -169,7 +72,7 @@ void read_objects(const Reader& r, const toml::node* node, Task& task) {
   }
 }
 
-void require_object(const Reader& r, const Task& task, const char* key, const std::string& name,
+void require_object(const TomlReader& r, const Task& task, const char* key, const std::string& name,
                     const char* kind) {
   const SceneObject* obj = task.find_object(name);
   if (obj == nullptr || obj->kind != kind) {
@@ -178,21 +81,21 @@ void require_object(const Reader& r, const Task& task, const char* key, const st
   }
 }
 
-void read_constraints(const Reader& r, Task& task) {
+void read_constraints(const TomlReader& r, Task& task) {
   r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
           "peak_height", "rotation"});
   TaskConstraints& c = task.constraints;
   c.weight = r.number("weight", 1e-6, 1e9);
   c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
   if (auto t = r.table("landing", false)) {
-    Reader s = r.sub("landing", *t);
+    TomlReader s = r.sub("landing", *t);
     s.only({"center", "half_width"});
     c.landing = true;
     c.landing_center = s.number("center", -20, 20);
     c.landing_half_width = s.number("half_width", 0.001, 10);
   }
   if (auto t = r.table("on_box", false)) {
-    Reader s = r.sub("on_box", *t);
+    TomlReader s = r.sub("on_box", *t);
     s.only({"object", "margin"});
     c.on_box = true;
     c.on_box_object = s.string("object");
@@ -200,7 +103,7 @@ void read_constraints(const Reader& r, Task& task) {
     c.on_box_margin = s.number("margin", 0, 5);
   }
   if (auto t = r.table("clearance", false)) {
-    Reader s = r.sub("clearance", *t);
+    TomlReader s = r.sub("clearance", *t);
     s.only({"object", "min_clearance"});
     c.clearance = true;
     c.clearance_object = s.string("object");
@@ -208,19 +111,19 @@ void read_constraints(const Reader& r, Task& task) {
     c.min_clearance = s.number("min_clearance", 0, 1);
   }
   if (auto t = r.table("min_length", false)) {
-    Reader s = r.sub("min_length", *t);
+    TomlReader s = r.sub("min_length", *t);
     s.only({"length"});
     c.min_length = true;
     c.min_length_value = s.number("length", -20, 20);
   }
   if (auto t = r.table("peak_height", false)) {
-    Reader s = r.sub("peak_height", *t);
+    TomlReader s = r.sub("peak_height", *t);
     s.only({"min"});
     c.peak_height = true;
     c.peak_height_min = s.number("min", 0, 5);
   }
   if (auto t = r.table("rotation", false)) {
-    Reader s = r.sub("rotation", *t);
+    TomlReader s = r.sub("rotation", *t);
     s.only({"turns", "tolerance", "penalty"});
     c.rotation = true;
     c.rotation_turns = s.number("turns", -3, 3);
@@ -229,7 +132,7 @@ void read_constraints(const Reader& r, Task& task) {
   }
 }
 
-void read_simulation(const Reader& r, Task& task) {
+void read_simulation(const TomlReader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
           "clearance_range", "timestep"});
   TaskSimulation& s = task.simulation;
@@ -242,7 +145,7 @@ void read_simulation(const Reader& r, Task& task) {
   s.timestep = r.number("timestep", 0, 0.01, s.timestep);
 }
 
-void read_seed(const Reader& r, Task& task) {
+void read_seed(const TomlReader& r, Task& task) {
   r.only({"base", "object", "heights", "generations", "sigma", "popsize", "seed", "robustness"});
   TaskSeed& s = task.seed;
   s.base = existing_file(r, "base");
@@ -271,7 +174,7 @@ void read_seed(const Reader& r, Task& task) {
   s.robustness = r.number("robustness", 0, 1e6, s.robustness);
 }
 
-void read_diversity(const Reader& r, Task& task) {
+void read_diversity(const TomlReader& r, Task& task) {
   r.only({"sigma0"});
   task.diversity.sigma0 = r.number("sigma0", 1e-4, 1, task.diversity.sigma0);
 }
@@ -297,7 +200,7 @@ Task load_task(const std::string& path) {
   }
   Task task;
   task.file = path;
-  Reader r(path, root, "");
+  TomlReader r(path, root, "");
   r.only({"name", "description", "character", "metric", "variations", "m0", "controller",
           "simulation", "objects", "constraints", "seed", "diversity"});
   task.name = r.string("name");

@@ -1,0 +1,116 @@
+// A strict reader of one TOML table, shared by every file format we parse (task files,
+// character files): unknown keys, wrong types, out-of-range or non-finite values and
+// missing fields are one-line UserErrors "FILE: FIELD: expected ...".
+#pragma once
+
+#include <cmath>
+#include <initializer_list>
+#include <sstream>
+#include <string>
+#include <toml++/toml.h>
+#include <vector>
+
+#include "core/error.h"
+
+namespace diverse {
+
+// A number as messages print it (shortest form, as iostream writes it).
+inline std::string num(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// Strict reader of one TOML table; `path` is the dotted name used in messages.
+class TomlReader {
+ public:
+  TomlReader(std::string file, const toml::table& table, std::string path)
+      : file_(std::move(file)), table_(table), path_(std::move(path)) {}
+
+  // Rejects keys not in `known`.
+  void only(std::initializer_list<const char*> known) const {
+    for (const auto& [key, node] : table_) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || key.str() == k;
+      if (!ok) {
+        std::string list;
+        for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
+        fail(std::string(key.str()), "expected no such key (unknown key; known keys: " + list + ")");
+      }
+    }
+  }
+  bool has(const char* key) const { return table_.contains(key); }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& expectation) const {
+    throw_field_error(file_, field(key), expectation);
+  }
+  std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  double number(const char* key, double lo, double hi) const {
+    const toml::node* n = table_.get(key);
+    const std::string expect = "expected a number in [" + num(lo) + ", " + num(hi) + "]";
+    if (n == nullptr) fail(key, expect + " (missing)");
+    double v = 0;
+    if (auto f = n->as_floating_point()) {
+      v = f->get();
+    } else if (auto i = n->as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(key, expect);
+    }
+    if (!std::isfinite(v) || v < lo || v > hi) fail(key, expect + ", got " + num(v));
+    return v;
+  }
+  double number(const char* key, double lo, double hi, double fallback) const {
+    return has(key) ? number(key, lo, hi) : fallback;
+  }
+  long long integer(const char* key, long long lo, long long hi) const {
+    const toml::node* n = table_.get(key);
+    const std::string expect =
+        "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (n == nullptr) fail(key, expect + " (missing)");
+    auto i = n->as_integer();
+    if (!i) fail(key, expect);
+    const long long v = i->get();
+    if (v < lo || v > hi) fail(key, expect + ", got " + std::to_string(v));
+    return v;
+  }
+  long long integer(const char* key, long long lo, long long hi, long long fallback) const {
+    return has(key) ? integer(key, lo, hi) : fallback;
+  }
+  std::string string(const char* key) const {
+    const toml::node* n = table_.get(key);
+    if (n == nullptr) fail(key, "expected a string (missing)");
+    auto s = n->as_string();
+    if (!s) fail(key, "expected a string");
+    return s->get();
+  }
+  std::string string(const char* key, const std::string& fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+  bool boolean(const char* key, bool fallback) const {
+    if (!has(key)) return fallback;
+    auto b = table_.get(key)->as_boolean();
+    if (!b) fail(key, "expected true or false");
+    return b->get();
+  }
+  const toml::table* table(const char* key, bool required) const {
+    const toml::node* n = table_.get(key);
+    if (n == nullptr) {
+      if (required) fail(key, "expected a table (missing)");
+      return nullptr;
+    }
+    if (!n->is_table()) fail(key, "expected a table");
+    return n->as_table();
+  }
+  TomlReader sub(const char* key, const toml::table& t) const { return TomlReader(file_, t, field(key)); }
+  const toml::table& raw() const { return table_; }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  const toml::table& table_;
+  std::string path_;
+};
+
+}  // namespace diverse
