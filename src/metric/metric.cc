@@ -72,25 +72,61 @@ double angle_difference(double a, double b) {
 }
 
 Pose make_pose(const Eigen::Matrix3Xd& world_link_com, const Eigen::VectorXd& link_mass,
-               const Eigen::VectorXd& angles) {
+               const Eigen::VectorXd& joint_angles, const Eigen::Quaterniond& root) {
   if (world_link_com.cols() != link_mass.size())
     throw std::logic_error("make_pose: one mass per link expected");
   const double total = link_mass.sum();
   if (!(total > 0.0)) throw std::logic_error("make_pose: total mass must be positive");
+  const double root_norm = root.norm();
+  if (!(std::isfinite(root_norm) && root_norm > 0.0))
+    throw std::logic_error("make_pose: the root orientation must be a finite, nonzero quaternion");
   const Eigen::Vector3d com = world_link_com * link_mass / total;
-  return Pose{world_link_com.colwise() - com, link_mass, angles};
+  Pose pose;
+  pose.link_com = world_link_com.colwise() - com;
+  pose.link_mass = link_mass;
+  pose.angles = joint_angles;
+  pose.root = Eigen::Quaterniond(root.coeffs() / root_norm);
+  return pose;
+}
+
+// Compatibility: serves callers that pass the planar root pitch as the last angle.
+Pose make_pose(const Eigen::Matrix3Xd& world_link_com, const Eigen::VectorXd& link_mass,
+               const Eigen::VectorXd& angles) {
+  if (angles.size() == 0)
+    return make_pose(world_link_com, link_mass, angles, Eigen::Quaterniond::Identity());
+  const Eigen::Index joints = angles.size() - 1;
+  return make_pose(world_link_com, link_mass, angles.head(joints), planar_root(angles[joints]));
+}
+
+Eigen::Quaterniond planar_root(double pitch) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(pitch, -Eigen::Vector3d::UnitY()));
+}
+
+double rotation_angle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  // r = conj(a) b takes a to b; its scalar part is <a, b>. atan2 of the vector part's
+  // norm over |scalar part| is half the rotation angle, accurate near 0 and near pi, and
+  // independent of the quaternions' norms. |w| picks the shorter of the two rotations
+  // that r and -r describe.
+  const Eigen::Quaterniond r = a.conjugate() * b;
+  return 2.0 * std::atan2(r.vec().norm(), std::abs(r.w()));
 }
 
 double pose_distance(Metric metric, const Pose& a, const Pose& b, const MetricLayout& layout) {
   switch (metric) {
     case Metric::kHandsFeet: {
+      if (a.link_com.cols() != b.link_com.cols())
+        throw std::logic_error("pose_distance: poses have different link counts");
       double sum = 0.0;
-      for (int link : layout.hand_foot_links)
+      for (int link : layout.hand_foot_links) {
+        if (link < 0 || link >= a.link_com.cols())
+          throw std::logic_error("pose_distance: a hand or foot link index is out of range");
         sum += (a.link_com.col(link) - b.link_com.col(link)).squaredNorm();
+      }
       return sum;
     }
     case Metric::kMassDistance: {
-      if (a.link_com.cols() != b.link_com.cols())
+      if (a.link_com.cols() != b.link_com.cols() || a.link_mass.size() != b.link_mass.size() ||
+          a.link_mass.size() != a.link_com.cols())
         throw std::logic_error("pose_distance: poses have different link counts");
       // Link masses are equal for the same character; the mean keeps d symmetric if not.
       const Eigen::VectorXd mass = 0.5 * (a.link_mass + b.link_mass);
@@ -99,15 +135,24 @@ double pose_distance(Metric metric, const Pose& a, const Pose& b, const MetricLa
           .sum();
     }
     case Metric::kWeightedJointAngles: {
-      if (a.angles.size() != b.angles.size() ||
-          a.angles.size() != layout.angle_weights.size())
-        throw std::logic_error("pose_distance: angle vectors and weights differ in size");
+      const Eigen::Index joints = a.angles.size();
+      if (b.angles.size() != joints)
+        throw std::logic_error("pose_distance: poses have different joint angle counts");
+      double root_weight = layout.root_weight;
+      if (layout.angle_weights.size() == joints + 1) {
+        // Compatibility: serves callers that pass the planar root pitch as the last angle
+        // (and so give its weight as the last angle weight).
+        root_weight = layout.angle_weights[joints];
+      } else if (layout.angle_weights.size() != joints) {
+        throw std::logic_error("pose_distance: expected one angle weight per joint angle");
+      }
       double sum = 0.0;
-      for (Eigen::Index i = 0; i < a.angles.size(); ++i) {
+      for (Eigen::Index i = 0; i < joints; ++i) {
         const double d = angle_difference(a.angles[i], b.angles[i]);
         sum += layout.angle_weights[i] * d * d;
       }
-      return sum;
+      const double root_angle = rotation_angle(a.root, b.root);
+      return sum + root_weight * root_angle * root_angle;
     }
     case Metric::kShape:
       break;
