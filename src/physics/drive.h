@@ -8,15 +8,32 @@
 // damping part is best integrated implicitly (MuJoCo's Euler integrator treats
 // dof_damping implicitly, so large kd stays stable at a 2 ms step), but an implicit damper
 // acts on the END-of-step velocity, which the controller does not know when it writes
-// ctrl; motor plus damper can then exceed the limit (around impacts by up to 1.7 times).
-// JointDrive applies the request so that, at every step, the torque the motor and the
-// damper apply together stays within the limit (docs/characters.md, "Torque limits"):
-// see apply() and check() below; run_rollout() (physics/rollout.h) does both.
+// ctrl. The Euler step solves (M + h D) qacc = f - D qvel_t and sets
+// qvel_{t+1} = qvel_t + h qacc, so M qacc = f - D qvel_{t+1}: the damper torque of the
+// step is -dof_damping * qvel_{t+1} (MuJoCo 2.2.2 documentation, "Computation",
+// "Numerical integration"). When an impact changes qvel within the step, motor plus
+// damper can exceed the limit (by up to 1.7 times around landings).
+//
+// The torque limit holds on the net torque (SPEC section 8), so each step is applied in
+// one of two ways per joint, chosen from the state at the step's start:
+//
+//  - implicit: dof_damping = kd, ctrl = u. Used when |u| <= limit and the request is not
+//    saturated, |u - kd qdot_t| <= limit. The net torque is u - kd qdot_{t+1}.
+//  - explicit: dof_damping = 0, ctrl = clamp(u - kd qdot_t). The net torque is ctrl, within
+//    the limit by construction (the motor's forcerange is the limit).
+//
+// An implicit joint can still exceed its limit if qdot_{t+1} jumps (an impact within the
+// step). run_rollout() (physics/rollout.h) therefore integrates, checks every implicit
+// joint's net torque on qdot_{t+1}, and if one exceeds its limit restores the state from
+// before the integration and integrates again with the violating joints explicit
+// (apply() and check() below). Everything mj_step1 computed depends only on the restored
+// state, so the step taken is exactly what plain mj_step computes from that state with the
+// final ctrl and dof_damping; the recorder logs those, and a replay repeats them bit for
+// bit.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
-#include <string>
 #include <vector>
 
 namespace diverse {
@@ -24,8 +41,14 @@ namespace diverse {
 struct DrivenJoint {
   int actuator = -1;   // a motor on the joint, gear 1, forcerange [-limit, limit]
   int dof = -1;        // the joint's dof address
-  double limit = 0;    // Nm, limit on the net torque (motor plus damping)
+  double limit = 0;    // Nm (N on a slide joint), limit on the net torque (motor plus damping)
 };
+
+// The driven joints of a model, derived from its actuators alone, so that a saved model
+// suffices to check a motion: each actuator that is a plain motor (no dynamics, fixed
+// gain 1, no bias) on a hinge or slide joint with gear 1, forcelimited with a symmetric
+// forcerange [-L, L], L > 0, on a joint no other actuator acts on. In actuator order.
+std::vector<DrivenJoint> driven_joints(const mjModel* m);
 
 class JointDrive {
  public:
@@ -34,34 +57,71 @@ class JointDrive {
 
   int size() const { return static_cast<int>(joints_.size()); }
   const std::vector<DrivenJoint>& joints() const { return joints_; }
-  // The dofs whose dof_damping the drive writes (for the step recorder).
+  // The dofs whose dof_damping the drive writes (for the step recorder), joint order.
   const std::vector<int>& dofs() const { return dofs_; }
 
-  // The request of this step for joint k: net torque u - kd * qdot (Nm), kd >= 0.
+  // The request of this step for joint k: net torque u - kd * qdot (Nm), kd >= 0
+  // (Nm s/rad). A request stands until the next set() of the same joint.
   void set(int k, double u, double kd) {
     u_[static_cast<size_t>(k)] = u;
     kd_[static_cast<size_t>(k)] = kd;
   }
   double u(int k) const { return u_[static_cast<size_t>(k)]; }
   double kd(int k) const { return kd_[static_cast<size_t>(k)]; }
+  // How the last step applied joint k's damping: in the motor (dof_damping 0) or not.
+  bool explicit_damping(int k) const { return explicit_[static_cast<size_t>(k)] != 0; }
 
-  // Implementation state, owned by physics/rollout.cc.
+  // How often steps were integrated again, since construction or reset_counts().
+  struct Counts {
+    long steps = 0;               // steps applied
+    long redone_steps = 0;        // steps integrated more than once
+    long redos = 0;               // extra integrations in all
+    long all_explicit_steps = 0;  // steps that fell back to every joint explicit
+  };
+  const Counts& counts() const { return counts_; }
+  void reset_counts() { counts_ = Counts{}; }
+
+  // The step protocol, in this order, between mj_step1 and the end of the step
+  // (run_rollout() follows it; tests may too):
+  //
+  // apply(): chooses each joint's way from the request and qdot_t (d->qvel after mj_step1)
+  // and writes d->ctrl and m->dof_damping. Returns true if any dof_damping changed: the
+  // passive forces mj_step1 computed are then stale and need mj_passive.
+  bool apply(mjModel* m, mjData* d);
+  // check(), after mj_step2: true if every implicit joint's net torque, motor force minus
+  // kd qdot_{t+1}, is within its limit (exactly, no tolerance), or if none is implicit.
+  // Otherwise switches the violating joints to explicit (every joint if `all_explicit`),
+  // rewrites d->ctrl and m->dof_damping and returns false: the caller restores the state
+  // from before mj_step2, calls mj_passive and mj_step2 again, and checks again.
+  bool check(mjModel* m, mjData* d, bool all_explicit);
+
+ private:
+  void make_explicit(mjModel* m, mjData* d, size_t k);
+
   std::vector<DrivenJoint> joints_;
   std::vector<int> dofs_;
   std::vector<double> u_, kd_;
+  std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
   std::vector<char> explicit_;  // per joint: damping applied explicitly in the motor
+  bool redone_ = false;         // the current step has been integrated again
+  Counts counts_;
 };
 
 // The largest net-torque excess over all steps of a record, as a fraction of the limit:
 // max over steps and driven joints of |motor + damper| / limit - 1 (<= 0 when every limit
-// holds). The damper torque of a step is -dof_damping * qvel at the END of the step, as
-// the Euler integrator applies it. Replays the record on `m` (a plain, freshly loaded
-// model; modified) with mj_step. Declared here, defined in physics/rollout.cc.
+// holds), where the motor torque is the actuator force and the damper torque is
+// -dof_damping * qvel at the END of the step, as the Euler integrator applies it. Replays
+// the record on `m` (a plain, freshly loaded model; its dof_damping is modified) with
+// mj_step; needs only the record's ctrl, damping and initial state. Defined in
+// physics/rollout.cc beside replay().
 struct StepRecorder;
 struct NetTorqueCheck {
-  double worst_excess = 0;     // max |net| / limit - 1
-  int worst_step = -1, worst_joint = -1;
-  int steps = 0, steps_over_1_percent = 0;
+  double worst_excess = 0;     // max |net| / limit - 1 over steps and joints
+  double worst_torque = 0;     // the net torque there (Nm)
+  int worst_step = -1, worst_joint = -1;  // index into the record's steps and `joints`
+  int steps = 0;               // steps replayed
+  int steps_over_1_percent = 0;  // steps where some joint exceeds its limit by > 1 %
+  bool blew_up = false;        // the replay hit a MuJoCo error or a non-finite state
 };
 NetTorqueCheck check_net_torque(mjModel* m, const StepRecorder& record,
                                 const std::vector<DrivenJoint>& joints);

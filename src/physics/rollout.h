@@ -7,6 +7,11 @@
 // the same inputs, so a recorded rollout replays bit for bit with plain mj_step (see
 // replay()).
 //
+// With a JointDrive (physics/drive.h) the hooks' control() writes the drive's requests
+// instead; the drive writes ctrl and dof_damping, and a step whose net joint torque would
+// exceed a limit is integrated again from the same state with those joints' damping made
+// explicit. Only the final integration's inputs are recorded, and they replay exactly.
+//
 // A rollout that goes unstable (a MuJoCo warning, a non-finite state, or a MuJoCo error
 // caught by the guard) stops and reports it; it never throws or aborts.
 #pragma once
@@ -16,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "physics/drive.h"
 #include "physics/model.h"
 
 namespace diverse {
@@ -23,7 +29,8 @@ namespace diverse {
 class StepHooks {
  public:
   virtual ~StepHooks() = default;
-  // Called after mj_step1: writes d->ctrl and may write m->dof_damping.
+  // Called after mj_step1: writes d->ctrl and may write m->dof_damping, or, in a rollout
+  // with a JointDrive, sets the drive's requests (the drive writes both).
   virtual void control(mjModel* m, mjData* d) = 0;
   // Called after control(), before integration. Return true to stop before this step.
   virtual bool observe(const mjModel* m, const mjData* d) = 0;
@@ -43,8 +50,9 @@ struct StepRecorder {
   };
   std::vector<DampingChange> damping;
   // Per step, row-major: ctrl (nu), resulting qpos (nq), actuator force of that step (nu)
-  // and the joint damping force of that step, -dof_damping * qvel at the step's start,
-  // for the damped dofs (ndamp), so motor plus damping gives the joint torque.
+  // and the joint damping force of that step for the damped dofs (ndamp),
+  // -dof_damping * qvel at the END of the step (the Euler integrator's damping is
+  // implicit, physics/drive.h), so motor plus damping gives the net joint torque.
   std::vector<double> ctrl, qpos, actuator_force, damping_force;
   int steps() const { return nu > 0 ? static_cast<int>(ctrl.size()) / nu : 0; }
 };
@@ -61,6 +69,12 @@ struct RolloutStats {
 // may write (recorded on change). `recorder` may be null.
 RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
                          const std::vector<int>& damped_dofs, StepRecorder* recorder);
+
+// The same with the joints driven through `drive`, whose requests the hooks set in
+// control(): the net torque of every driven joint stays within its limit at every step
+// (physics/drive.h). The recorder's damped dofs are drive.dofs().
+RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps, JointDrive& drive,
+                         StepRecorder* recorder);
 
 // Replays a record on `m` (a plain, freshly loaded model) with mj_step and returns the
 // largest |qpos difference| from the recorded qpos over all steps. `m` is modified
