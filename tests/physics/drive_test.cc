@@ -1,0 +1,386 @@
+// Joint drives (physics/drive.h): the net torque, motor plus the implicit damper on the
+// end-of-step velocity, stays within each joint's limit at every step through impacts,
+// where applying the damping the old way (ctrl = clamp(tau) + kd qdot_t, dof_damping = kd)
+// exceeds it; a rollout with integrations redone replays bit for bit in plain MuJoCo; far
+// from the limits the drive is plain implicit PD; and check_net_torque() gives the
+// closed-form answer on a sliding block.
+#include "physics/drive.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "physics/model.h"
+#include "physics/rollout.h"
+
+namespace diverse {
+namespace {
+
+const std::string kHuman = std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human2d.xml";
+
+// A horizontal arm held by a stiff, heavily damped PD; a 5 kg box falls on its tip.
+// The impact changes the arm's velocity within one step, which an implicit damper of
+// kd = 200 Nm s/rad turns into a torque far beyond the motor's 20 Nm.
+constexpr const char* kArmHitByBox = R"(
+<mujoco>
+  <option timestep="0.002" integrator="Euler"/>
+  <worldbody>
+    <geom type="plane" size="5 5 0.1"/>
+    <body pos="0 0 1">
+      <joint name="shoulder" type="hinge" axis="0 -1 0" range="-1.2 1.2" limited="true"/>
+      <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1"/>
+    </body>
+    <body pos="0.45 0 1.8">
+      <freejoint/>
+      <geom type="box" size="0.05 0.05 0.05" mass="5"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="shoulder" forcelimited="true" forcerange="-20 20"/>
+  </actuator>
+</mujoco>)";
+
+// A two-link arm swung by its shoulder and elbow into a heavy box standing in its way.
+constexpr const char* kTwoLinkArm = R"(
+<mujoco>
+  <option timestep="0.002" integrator="Euler"/>
+  <worldbody>
+    <geom type="plane" size="5 5 0.1"/>
+    <geom type="box" pos="0.55 0 0.6" size="0.1 0.1 0.6" solref="0.004 1"/>
+    <body pos="0 0 1.2">
+      <joint name="shoulder" type="hinge" axis="0 -1 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.04" mass="2"/>
+      <body pos="0 0 -0.4">
+        <joint name="elbow" type="hinge" axis="0 -1 0" range="-2.5 2.5" limited="true"/>
+        <geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.035" mass="1.5"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="shoulder" forcelimited="true" forcerange="-80 80"/>
+    <motor joint="elbow" forcelimited="true" forcerange="-40 40"/>
+  </actuator>
+</mujoco>)";
+
+// The qpos address of each driven joint.
+std::vector<int> qpos_of(const mjModel* m, const std::vector<DrivenJoint>& joints) {
+  std::vector<int> out;
+  for (const DrivenJoint& j : joints) out.push_back(m->jnt_qposadr[m->dof_jntid[j.dof]]);
+  return out;
+}
+
+// PD toward fixed targets: u = kp (target - q), damping kd.
+struct Pd {
+  std::vector<double> target, kp, kd;
+};
+
+// The drive's way: the hooks set requests, the drive applies them.
+class DrivenPd : public StepHooks {
+ public:
+  DrivenPd(const mjModel* m, JointDrive* drive, Pd pd)
+      : drive_(drive), qpos_(qpos_of(m, drive->joints())), pd_(std::move(pd)) {}
+  void control(mjModel*, mjData* d) override {
+    for (int k = 0; k < drive_->size(); ++k) {
+      const size_t i = static_cast<size_t>(k);
+      drive_->set(k, pd_.kp[i] * (pd_.target[i] - d->qpos[qpos_[i]]), pd_.kd[i]);
+    }
+  }
+  bool observe(const mjModel*, const mjData*) override { return false; }
+
+ private:
+  JointDrive* drive_;
+  std::vector<int> qpos_;
+  Pd pd_;
+};
+
+// The old way: the clamped PD torque with the damping added back to the motor, the
+// damping itself implicit in dof_damping (so the motor and damper need not cancel).
+// `clamp` false gives plain implicit PD: ctrl = u, dof_damping = kd.
+class OldPd : public StepHooks {
+ public:
+  OldPd(const mjModel* m, std::vector<DrivenJoint> joints, Pd pd, bool clamp)
+      : joints_(std::move(joints)), qpos_(qpos_of(m, joints_)), pd_(std::move(pd)), clamp_(clamp) {}
+  void control(mjModel* m, mjData* d) override {
+    for (size_t k = 0; k < joints_.size(); ++k) {
+      const DrivenJoint& j = joints_[k];
+      const double u = pd_.kp[k] * (pd_.target[k] - d->qpos[qpos_[k]]);
+      const double qd = d->qvel[j.dof];
+      d->ctrl[j.actuator] = clamp_ ? std::clamp(u - pd_.kd[k] * qd, -j.limit, j.limit) + pd_.kd[k] * qd : u;
+      m->dof_damping[j.dof] = pd_.kd[k];
+    }
+  }
+  bool observe(const mjModel*, const mjData*) override { return false; }
+  std::vector<int> dofs() const {
+    std::vector<int> out;
+    for (const DrivenJoint& j : joints_) out.push_back(j.dof);
+    return out;
+  }
+
+ private:
+  std::vector<DrivenJoint> joints_;
+  std::vector<int> qpos_;
+  Pd pd_;
+  bool clamp_;
+};
+
+// One scene: a model, PD gains and an initial state.
+struct Scene {
+  std::shared_ptr<const SharedModel> model;
+  Pd pd;
+  std::vector<double> qpos0, qvel0;  // empty: the model's qpos0, zero velocity
+};
+
+void set_initial_state(const Scene& s, SimWorker& w) {
+  w.reset();
+  mjData* d = w.data();
+  if (!s.qpos0.empty()) std::copy(s.qpos0.begin(), s.qpos0.end(), d->qpos);
+  if (!s.qvel0.empty()) std::copy(s.qvel0.begin(), s.qvel0.end(), d->qvel);
+}
+
+struct Outcome {
+  RolloutStats stats;
+  StepRecorder record;
+  JointDrive::Counts counts;
+  NetTorqueCheck check;  // on a fresh copy of the model, as `diverse replay` does
+  double replay_diff = -1;
+};
+
+// Replays the record on fresh model copies: the net-torque check and the qpos difference.
+void replay_checks(const Scene& s, Outcome* o) {
+  mjModel* m = mj_copyModel(nullptr, s.model->get());
+  o->check = check_net_torque(m, o->record, driven_joints(s.model->get()));
+  mj_deleteModel(m);
+  m = mj_copyModel(nullptr, s.model->get());
+  o->replay_diff = replay(m, o->record);
+  mj_deleteModel(m);
+}
+
+Outcome run_driven(const Scene& s, int steps) {
+  SimWorker worker(s.model);
+  set_initial_state(s, worker);
+  JointDrive drive(driven_joints(s.model->get()));
+  DrivenPd hooks(worker.model(), &drive, s.pd);
+  Outcome o;
+  o.stats = run_rollout(worker, hooks, steps, drive, &o.record);
+  o.counts = drive.counts();
+  replay_checks(s, &o);
+  return o;
+}
+
+Outcome run_old(const Scene& s, int steps, bool clamp) {
+  SimWorker worker(s.model);
+  set_initial_state(s, worker);
+  OldPd hooks(worker.model(), driven_joints(s.model->get()), s.pd, clamp);
+  Outcome o;
+  o.stats = run_rollout(worker, hooks, steps, hooks.dofs(), &o.record);
+  replay_checks(s, &o);
+  return o;
+}
+
+Scene arm_hit_by_box() {
+  Scene s{SharedModel::from_xml(kArmHitByBox, "arm_hit_by_box"), {{0}, {200}, {200}}, {}, {}};
+  return s;
+}
+
+Scene two_link_arm() {
+  Scene s{SharedModel::from_xml(kTwoLinkArm, "two_link_arm"), {{2.0, 0.3}, {800, 400}, {120, 60}}, {}, {}};
+  return s;
+}
+
+// The planar human dropped from 0.4 m onto its feet, held by PD in a slight crouch.
+Scene human_drop() {
+  Scene s{SharedModel::from_file(kHuman), {}, {}, {}};
+  const mjModel* m = s.model->get();
+  s.qpos0.assign(m->qpos0, m->qpos0 + m->nq);
+  s.qpos0[static_cast<size_t>(m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "rootz")])] = 0.4;
+  for (const DrivenJoint& j : driven_joints(m)) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j.dof]);
+    const std::string n = name;
+    double target = 0;
+    if (n.rfind("hip", 0) == 0) target = 0.4;
+    if (n.rfind("knee", 0) == 0) target = -0.8;
+    if (n.rfind("ankle", 0) == 0) target = 0.4;
+    s.pd.target.push_back(target);
+    s.pd.kp.push_back(4 * j.limit);
+    s.pd.kd.push_back(0.4 * j.limit);
+  }
+  return s;
+}
+
+void print(const char* what, const Outcome& o) {
+  std::printf("%-28s steps %4d  worst excess %+8.4f at step %4d joint %d  over 1%%: %4d  "
+              "redone %ld (redos %ld, all explicit %ld)  replay diff %g\n",
+              what, o.stats.steps, o.check.worst_excess, o.check.worst_step, o.check.worst_joint,
+              o.check.steps_over_1_percent, o.counts.redone_steps, o.counts.redos,
+              o.counts.all_explicit_steps, o.replay_diff);
+}
+
+// (a) The net torque stays within the limit through the impacts, exactly; the old way
+// exceeds it on the same scenes (so this test fails without the drive).
+TEST(JointDrive, NetTorqueHoldsThroughImpactsWhereTheOldWayExceedsIt) {
+  const Scene scenes[] = {arm_hit_by_box(), two_link_arm(), human_drop()};
+  const char* names[] = {"arm hit by box", "two-link arm into box", "human dropped"};
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE(names[i]);
+    const Outcome old = run_old(scenes[i], 600, true);
+    const Outcome driven = run_driven(scenes[i], 600);
+    print((std::string(names[i]) + ", old").c_str(), old);
+    print((std::string(names[i]) + ", drive").c_str(), driven);
+    ASSERT_FALSE(old.stats.unstable) << old.stats.instability;
+    ASSERT_FALSE(driven.stats.unstable) << driven.stats.instability;
+    EXPECT_GT(old.check.worst_excess, 0.05);
+    EXPECT_GT(old.check.steps_over_1_percent, 0);
+    EXPECT_EQ(driven.check.steps, 600);
+    EXPECT_LE(driven.check.worst_excess, 0.0);
+    EXPECT_EQ(driven.check.steps_over_1_percent, 0);
+    // The recorder's own torques say the same: motor plus the damper on the
+    // end-of-step velocity.
+    const std::vector<DrivenJoint> joints = driven_joints(scenes[i].model->get());
+    const StepRecorder& r = driven.record;
+    for (int step = 0; step < r.steps(); ++step) {
+      for (size_t k = 0; k < joints.size(); ++k) {
+        const double net = r.actuator_force[static_cast<size_t>(step * r.nu + joints[k].actuator)] +
+                           r.damping_force[static_cast<size_t>(step * r.ndamp) + k];
+        ASSERT_LE(std::fabs(net), joints[k].limit) << "step " << step << " joint " << k;
+      }
+    }
+  }
+}
+
+// (b) Steps integrated more than once replay bit for bit with plain mj_step and the
+// recorded final ctrl and dof_damping.
+TEST(JointDrive, RedoneStepsReplayExactly) {
+  const Scene scenes[] = {arm_hit_by_box(), two_link_arm(), human_drop()};
+  long redone = 0;
+  for (const Scene& s : scenes) {
+    const Outcome o = run_driven(s, 600);
+    EXPECT_EQ(o.replay_diff, 0.0);
+    redone += o.counts.redone_steps;
+  }
+  EXPECT_GT(redone, 0);
+  // Each scene on its own too: the arm's impact needs a redo.
+  EXPECT_GT(run_driven(arm_hit_by_box(), 600).counts.redone_steps, 0);
+}
+
+// (c) Far from the limits the drive is plain implicit PD (ctrl = u, dof_damping = kd),
+// bit for bit, and never integrates twice.
+TEST(JointDrive, FarFromTheLimitsItIsPlainImplicitPd) {
+  Scene s = arm_hit_by_box();
+  std::string xml = kArmHitByBox;
+  xml.replace(xml.find("-20 20"), 6, "-1e6 1e6");
+  s.model = SharedModel::from_xml(xml, "arm_hit_by_box_strong");
+  const Outcome driven = run_driven(s, 600);
+  const Outcome plain = run_old(s, 600, false);
+  EXPECT_EQ(driven.counts.redos, 0);
+  ASSERT_EQ(driven.record.qpos.size(), plain.record.qpos.size());
+  EXPECT_EQ(driven.record.qpos, plain.record.qpos);
+  EXPECT_EQ(driven.record.ctrl, plain.record.ctrl);
+}
+
+// (d) A 1 kg block on a slide joint, no gravity: the Euler step solves
+// (m + h kd) a = ctrl - kd v0, and the net force motor + damper is m a.
+TEST(CheckNetTorque, SlidingBlockHasTheClosedFormNetForce) {
+  constexpr const char* kBlock = R"(
+<mujoco>
+  <option timestep="0.01" integrator="Euler" gravity="0 0 0"/>
+  <worldbody>
+    <body>
+      <joint name="slide" type="slide" axis="1 0 0"/>
+      <geom type="sphere" size="0.1" mass="1" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+  <actuator><motor joint="slide" forcelimited="true" forcerange="-1 1"/></actuator>
+</mujoco>)";
+  auto model = SharedModel::from_xml(kBlock, "block");
+  const std::vector<DrivenJoint> joints = driven_joints(model->get());
+  ASSERT_EQ(joints.size(), 1u);
+  EXPECT_EQ(joints[0].actuator, 0);
+  EXPECT_EQ(joints[0].dof, 0);
+  EXPECT_EQ(joints[0].limit, 1.0);
+
+  StepRecorder r;
+  r.nq = 1;
+  r.nu = 1;
+  r.ndamp = 1;
+  r.timestep = 0.01;
+  r.qpos0 = {0};
+  r.qvel0 = {-1};
+  r.damped_dofs = {0};
+  // Step 0: ctrl 1 against v0 = -1 with kd = 2: a = (1 + 2) / (1 + 0.02), net 3 / 1.02,
+  // 194 % over the 1 N limit. Step 1: no damping, ctrl 0.5: net 0.5, 50 % under.
+  r.damping = {{0, {2.0}}, {1, {0.0}}};
+  r.ctrl = {1.0, 0.5};
+  mjModel* m = mj_copyModel(nullptr, model->get());
+  const NetTorqueCheck c = check_net_torque(m, r, joints);
+  mj_deleteModel(m);
+  EXPECT_EQ(c.steps, 2);
+  EXPECT_FALSE(c.blew_up);
+  EXPECT_NEAR(c.worst_torque, 3 / 1.02, 1e-12);
+  EXPECT_NEAR(c.worst_excess, 3 / 1.02 - 1, 1e-12);
+  EXPECT_EQ(c.worst_step, 0);
+  EXPECT_EQ(c.worst_joint, 0);
+  EXPECT_EQ(c.steps_over_1_percent, 1);
+
+  // Only step 1: within the limit, the worst excess is 0.5 / 1 - 1.
+  r.damping = {{0, {0.0}}};
+  r.ctrl = {0.5};
+  m = mj_copyModel(nullptr, model->get());
+  const NetTorqueCheck within = check_net_torque(m, r, joints);
+  mj_deleteModel(m);
+  EXPECT_NEAR(within.worst_excess, -0.5, 1e-12);
+  EXPECT_EQ(within.steps_over_1_percent, 0);
+}
+
+// Only plain motors with gear 1 and a symmetric force limit on a hinge or slide joint
+// that nothing else drives count as driven joints.
+TEST(DrivenJoints, FromActuatorsAlone) {
+  constexpr const char* kMixed = R"(
+<mujoco>
+  <worldbody>
+    <body><joint name="a" type="hinge"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="b" type="hinge"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="c" type="hinge"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="d" type="slide"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="e" type="hinge"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="f" type="ball"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="g" type="hinge"/><geom size="0.1" mass="1"/></body>
+    <body><joint name="h" type="hinge"/><geom size="0.1" mass="1"/></body>
+  </worldbody>
+  <actuator>
+    <motor joint="a" forcelimited="true" forcerange="-30 30"/>
+    <motor joint="b" gear="2" forcelimited="true" forcerange="-30 30"/>
+    <motor joint="c" forcelimited="true" forcerange="-20 30"/>
+    <motor joint="d" forcelimited="true" forcerange="-5 5"/>
+    <motor joint="e"/>
+    <motor joint="f" forcelimited="true" forcerange="-30 30"/>
+    <position joint="g" kp="10" forcelimited="true" forcerange="-30 30"/>
+    <motor joint="h" forcelimited="true" forcerange="-30 30"/>
+    <motor joint="h" forcelimited="true" forcerange="-30 30"/>
+  </actuator>
+</mujoco>)";
+  auto model = SharedModel::from_xml(kMixed, "mixed");
+  const mjModel* m = model->get();
+  const std::vector<DrivenJoint> joints = driven_joints(m);
+  ASSERT_EQ(joints.size(), 2u);
+  EXPECT_EQ(joints[0].actuator, 0);
+  EXPECT_EQ(joints[0].dof, m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "a")]);
+  EXPECT_EQ(joints[0].limit, 30.0);
+  EXPECT_EQ(joints[1].actuator, 3);
+  EXPECT_EQ(joints[1].dof, m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "d")]);
+  EXPECT_EQ(joints[1].limit, 5.0);
+
+  // The planar human: its 16 hinge motors, with the limits of SPEC section 3.
+  auto human = SharedModel::from_file(kHuman);
+  const std::vector<DrivenJoint> body = driven_joints(human->get());
+  ASSERT_EQ(body.size(), 16u);
+  for (const DrivenJoint& j : body) {
+    EXPECT_TRUE(j.limit == 300 || j.limit == 200 || j.limit == 50) << j.limit;
+  }
+}
+
+}  // namespace
+}  // namespace diverse
