@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "character/planar_human.h"
+#include "character/character.h"
 #include "character/shape.h"
 #include "core/rng.h"
 #include "physics/model.h"
@@ -32,7 +32,7 @@ double thread_seconds() {
 }
 
 struct Fixture {
-  Fixture() : evaluator(load_task(kTask)), shapes(scene_xml(evaluator.task()), evaluator.task().character) {
+  Fixture() : evaluator(load_task(kTask)), shapes(scene_xml(evaluator.task()), evaluator.task().model) {
     params = evaluator.load_parameters(evaluator.task().m0);
     // Median CPU time of a few M0 rollouts, for the ratio.
     auto worker = evaluator.make_worker();
@@ -95,7 +95,7 @@ void BM_ShapeBuild(benchmark::State& state) {
   const double start = thread_seconds();
   for (auto _ : state) {
     auto model = f.shapes.compile(random_shape(f.shapes, rng));
-    const PlanarHuman body(model->get());
+    const Character body = bind_character(f.evaluator.task().character_spec, model->get(), "shape");
     SimWorker worker(model);
     worker.reset();
     benchmark::DoNotOptimize(worker.data()->qpos[0]);

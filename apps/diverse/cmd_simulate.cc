@@ -59,11 +59,11 @@ void run(const SimulateArgs& args) {
   std::printf("C = %.6g%s%s\n", e.constraint, e.fell ? ", fell: " : "",
               e.fell ? e.summary.fall_reason.c_str() : "");
   if (e.failed) std::printf("failed: %s\n", e.failure.c_str());
-  for (int p = 0; p < kNumJumpPhases; ++p) {
+  for (size_t p = 0; p < e.phases.names.size(); ++p) {
     if (e.phases.begin[p] < 0) {
-      std::printf("  phase %-7s not reached\n", jump_phase_name(p));
+      std::printf("  phase %-7s not reached\n", e.phases.names[p].c_str());
     } else {
-      std::printf("  phase %-7s begins at %.3f s\n", jump_phase_name(p), e.phases.begin[p]);
+      std::printf("  phase %-7s begins at %.3f s\n", e.phases.names[p].c_str(), e.phases.begin[p]);
     }
   }
   const MotionSummary& s = e.summary;

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/error.h"
+#include "core/toml_reader.h"
+
 namespace diverse {
 namespace {
 
 constexpr const char* kPhaseNames[kNumJumpPhases] = {"start", "crouch", "extend",
                                                      "rise",  "fall",   "land"};
-constexpr int kPoseTypes = 8;  // hip .. wrist; neck and head are not parameters
 constexpr const char* kGainJoints[3] = {"hip", "knee", "ankle"};
 
 bool is_stance(int phase) { return phase == kStart || phase == kCrouch || phase == kExtend || phase == kLand; }
@@ -17,34 +19,138 @@ bool has_balance(int phase) { return phase == kStart || phase == kCrouch || phas
 
 double wrap(double a) { return std::remainder(a, 2 * M_PI); }
 
-// Parameter name of a pose entry: stance phases name the world-frame quantities.
-std::string pose_name(int phase, int type) {
-  std::string joint = joint_type_name(type);
-  if (is_stance(phase)) {
-    if (type == kHip) joint = "pelvis";
-    if (type == kAnkle) joint = "foot";
-    if (type == kWaistUpper) joint = "chest";
+// World-pitch ranges (rad) of the links tracked in stance: pelvis, foot, chest.
+constexpr double kPelvisRange[2] = {-1.4, 1.4};
+constexpr double kFootRange[2] = {-1.0, 0.4};
+constexpr double kChestRange[2] = {-1.4, 1.4};
+
+// The groups a jump2d controller drives, by role.
+struct Layout {
+  int hip = -1, knee = -1, ankle = -1, chest = -1;
+  std::vector<int> posed;  // parameterized groups, character order (not role neck)
+};
+
+Layout layout_of(const Character& body) {
+  Layout l;
+  l.hip = body.find_group(JointRole::kHip);
+  l.knee = body.find_group(JointRole::kKnee);
+  l.ankle = body.find_group(JointRole::kAnkle);
+  // The topmost waist group: the one whose joint has the longest chain from the root.
+  size_t depth = 0;
+  for (size_t g = 0; g < body.groups.size(); ++g) {
+    if (body.groups[g].role != JointRole::kWaist) continue;
+    const size_t d = body.chain(body.groups[g].joints[0]).size();
+    if (l.chest < 0 || d > depth) {
+      l.chest = static_cast<int>(g);
+      depth = d;
+    }
   }
-  return std::string(kPhaseNames[phase]) + "." + joint;
+  for (size_t g = 0; g < body.groups.size(); ++g) {
+    if (body.groups[g].role != JointRole::kNeck) l.posed.push_back(static_cast<int>(g));
+  }
+  return l;
 }
 
-// Ranges (rad). Stance: world pitches for pelvis, foot and chest. Flight: joint ranges
-// of the model.
-ParamSpec pose_spec(int phase, int type) {
-  static constexpr double kFlight[kPoseTypes][2] = {
-      {-0.5, 2.4}, {-2.6, 0.0}, {-0.9, 0.7}, {-0.7, 0.4},
-      {-0.7, 0.4}, {-1.0, 3.1}, {0.0, 2.6},  {-1.2, 1.2}};
-  static constexpr double kStance[kPoseTypes][2] = {
-      {-1.4, 1.4}, {-2.6, 0.0}, {-1.0, 0.4}, {-0.7, 0.4},
-      {-1.4, 1.4}, {-1.0, 3.1}, {0.0, 2.6},  {-1.2, 1.2}};
-  const auto& r = is_stance(phase) ? kStance[type] : kFlight[type];
-  return {pose_name(phase, type), r[0], r[1], "rad"};
+// Parameter name of a pose entry: stance phases name the world-frame quantities.
+std::string pose_name(int phase, const Character& body, const Layout& l, int group) {
+  std::string name = body.groups[static_cast<size_t>(group)].name;
+  if (is_stance(phase)) {
+    if (group == l.hip) name = "pelvis";
+    if (group == l.ankle) name = "foot";
+    if (group == l.chest) name = "chest";
+  }
+  return std::string(kPhaseNames[phase]) + "." + name;
 }
 
-std::vector<ParamSpec> make_specs() {
+ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group) {
+  const CharacterJoint& j = body.joints[static_cast<size_t>(body.groups[static_cast<size_t>(group)].joints[0])];
+  double lo = j.lower, hi = j.upper;
+  if (!std::isfinite(lo) || !std::isfinite(hi)) {
+    lo = -M_PI;
+    hi = M_PI;
+  }
+  if (is_stance(phase)) {
+    const double* r = group == l.hip ? kPelvisRange : group == l.ankle ? kFootRange : group == l.chest ? kChestRange : nullptr;
+    if (r != nullptr) {
+      lo = r[0];
+      hi = r[1];
+    }
+  }
+  return {pose_name(phase, body, l, group), lo, hi, "rad"};
+}
+
+}  // namespace
+
+const char* jump_phase_name(int phase) {
+  return (phase >= 0 && phase < kNumJumpPhases) ? kPhaseNames[phase] : "?";
+}
+
+std::shared_ptr<const ControllerConfig> JumpControllerConfig::with_landing_height(double height) const {
+  auto c = std::make_shared<JumpControllerConfig>(*this);
+  c->landing_height_m = height;
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------
+// The plug-in.
+
+std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const TomlReader& r) const {
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "balance_kp",
+          "balance_kd", "balance_max_force", "gravity_compensation"});
+  auto c = std::make_shared<JumpControllerConfig>();
+  c->landing_control = r.boolean("landing_control", c->landing_control);
+  c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
+  c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
+  c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
+  c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
+  c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
+  c->gravity_compensation = r.number("gravity_compensation", 0, 2, c->gravity_compensation);
+  return c;
+}
+
+void JumpControllerType::check(const Character& body, const std::string& task_file) const {
+  const std::string who = "the character " + body.spec->file;
+  if (body.root != RootKind::kPlanar) {
+    throw_field_error(task_file, "controller.type",
+                      "expected a character with a planar root for \"jump2d\", but " + who + " has a free root");
+  }
+  for (JointRole role : {JointRole::kHip, JointRole::kKnee, JointRole::kAnkle}) {
+    const int g = body.find_group(role);
+    if (g < 0) {
+      throw_field_error(task_file, "controller.type",
+                        std::string("expected a joint group with role \"") + to_string(role) +
+                            "\" for \"jump2d\", but " + who + " has none");
+    }
+    if (body.groups[static_cast<size_t>(g)].joints.size() != 2) {
+      throw_field_error(task_file, "controller.type",
+                        std::string("expected a left/right pair in the \"") + to_string(role) +
+                            "\" group for \"jump2d\" (two legs), in " + who);
+    }
+  }
+}
+
+std::vector<ParamSpec> JumpControllerType::parameter_specs(const Character& body,
+                                                           const ControllerConfig&) const {
+  return JumpController::parameter_specs(body);
+}
+
+std::unique_ptr<Controller> JumpControllerType::make(const Character& body, const ControllerConfig& config,
+                                                     const std::vector<double>& values) const {
+  const auto* c = dynamic_cast<const JumpControllerConfig*>(&config);
+  if (c == nullptr) throw std::logic_error("jump2d: configuration of another controller");
+  auto controller = std::make_unique<JumpController>(body, *c);
+  controller->set_parameters(values);
+  return controller;
+}
+
+// ---------------------------------------------------------------------------------------
+// The controller.
+
+std::vector<ParamSpec> JumpController::parameter_specs(const Character& body) {
+  const Layout l = layout_of(body);
   std::vector<ParamSpec> specs;
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (int t = 0; t < kPoseTypes; ++t) specs.push_back(pose_spec(p, t));
+    for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
     for (int j = 0; j < 3; ++j) {
       const std::string prefix = std::string(kPhaseNames[p]) + ".";
       const double kp_hi = j == 2 ? 1500 : 2000;
@@ -61,52 +167,54 @@ std::vector<ParamSpec> make_specs() {
   return specs;
 }
 
-}  // namespace
-
-const char* jump_phase_name(int phase) {
-  return (phase >= 0 && phase < kNumJumpPhases) ? kPhaseNames[phase] : "?";
-}
-
-ContactState scan_contacts(const mjModel* m, const mjData* d, const PlanarHuman& body) {
-  ContactState c;
-  for (int i = 0; i < d->ncon; ++i) {
-    const mjContact& con = d->contact[i];
-    if (con.exclude != 0) continue;  // in the margin gap: near, not touching
-    for (int g : {con.geom1, con.geom2}) {
-      const int b = m->geom_bodyid[g];
-      if (b == 0 || m->body_rootid[b] != body.pelvis) continue;
-      c.any = true;
-      if (g == body.foot_geom[0]) {
-        c.foot[0] = true;
-      } else if (g == body.foot_geom[1]) {
-        c.foot[1] = true;
-      } else {
-        c.non_foot = true;
-      }
-    }
-  }
-  return c;
-}
-
-const std::vector<ParamSpec>& JumpController::parameter_specs() {
-  static const std::vector<ParamSpec> specs = make_specs();
-  return specs;
-}
-
-JumpController::JumpController(const PlanarHuman& body, const JumpControllerConfig& config)
+JumpController::JumpController(const Character& body, const JumpControllerConfig& config)
     : body_(body), config_(config) {
-  from_.assign(body_.joints.size(), 0.0);
-  target_.assign(body_.joints.size(), 0.0);
-  for (const PlanarJoint& j : body_.joints) damped_dofs_.push_back(j.dof);
+  const Layout l = layout_of(body);
+  hip_ = l.hip;
+  knee_ = l.knee;
+  ankle_ = l.ankle;
+  chest_ = l.chest;
+  posed_ = l.posed;
+  pose_slot_.assign(body.groups.size(), -1);
+  for (size_t k = 0; k < posed_.size(); ++k) pose_slot_[static_cast<size_t>(posed_[k])] = static_cast<int>(k);
+  gain_slot_.assign(body.groups.size(), -1);
+  gain_slot_[static_cast<size_t>(hip_)] = 0;
+  gain_slot_[static_cast<size_t>(knee_)] = 1;
+  gain_slot_[static_cast<size_t>(ankle_)] = 2;
+  tracked_.assign(body.joints.size(), Tracked::kNone);
+  side_.assign(body.joints.size(), 0);
+  for (size_t i = 0; i < body.joints.size(); ++i) {
+    const int g = body.joints[i].group;
+    if (g == hip_) tracked_[i] = Tracked::kParent;
+    if (g == ankle_ || g == chest_) tracked_[i] = Tracked::kChild;
+    side_[i] = body.joints[i].side == Side::kRight ? 1 : 0;
+  }
+  auto distance = [&](int a, int b) {
+    const auto& p = body.joints[static_cast<size_t>(a)].anchor0;
+    const auto& q = body.joints[static_cast<size_t>(b)].anchor0;
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+  };
+  const int hip0 = body.groups[static_cast<size_t>(hip_)].joints[0];
+  const int knee0 = body.groups[static_cast<size_t>(knee_)].joints[0];
+  const int ankle0 = body.groups[static_cast<size_t>(ankle_)].joints[0];
+  thigh_length_ = distance(hip0, knee0);
+  shin_length_ = distance(knee0, ankle0);
+  for (auto& p : pose_) p.assign(posed_.size(), 0.0);
+  from_.assign(body.joints.size(), 0.0);
+  target_.assign(body.joints.size(), 0.0);
+  balance_.assign(body.joints.size(), 0.0);
+  times_.names.assign(kPhaseNames, kPhaseNames + kNumJumpPhases);
+  times_.begin.assign(kNumJumpPhases, -1.0);
+  times_.rise = kRise;
+  times_.fall = kFall;
+  times_.land = kLand;
 }
 
 void JumpController::set_parameters(const std::vector<double>& values) {
-  const auto& specs = parameter_specs();
-  if (values.size() != specs.size()) throw std::logic_error("JumpController: parameter count");
+  if (values.size() != parameter_specs(body_).size()) throw std::logic_error("JumpController: parameter count");
   size_t k = 0;
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (auto& v : pose_[p]) v = 0;
-    for (int t = 0; t < kPoseTypes; ++t) pose_[p][t] = values[k++];
+    for (size_t g = 0; g < posed_.size(); ++g) pose_[p][g] = values[k++];
     for (int j = 0; j < 3; ++j) {
       kp_[p][j] = values[k++];
       kd_[p][j] = values[k++];
@@ -120,15 +228,15 @@ void JumpController::set_parameters(const std::vector<double>& values) {
   landing_velocity_gain_ = values[k++];
 }
 
-void JumpController::reset(mjModel* m, const mjData* d) {
+void JumpController::reset(const mjModel* m, const mjData* d) {
   q_ = d->qpos;
   from_is_world_ = true;  // start is a stance phase
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     target_[i] = d->qpos[body_.joints[i].qpos];
-    from_[i] = to_world(body_.joints[i].type, static_cast<int>(i), q_, target_[i]);
+    from_[i] = to_world(static_cast<int>(i), q_, target_[i]);
   }
   gravity_ = -m->opt.gravity[2];
-  times_ = PhaseTimes();
+  std::fill(times_.begin.begin(), times_.begin.end(), -1.0);
   extend_timed_out_ = false;
   phase_ = kStart;
   phase_begin_ = d->time;
@@ -136,25 +244,19 @@ void JumpController::reset(mjModel* m, const mjData* d) {
   times_.begin[kStart] = d->time;
   takeoff_com_z_ = 0;
   free_since_ = -1;
-  for (size_t i = 0; i < body_.joints.size(); ++i) {
-    const int type = body_.joints[i].type;
-    m->dof_damping[body_.joints[i].dof] = type <= kAnkle ? kd_[kStart][type] : config_.kd[type];
-  }
 }
 
-void JumpController::enter(int phase, double time, mjModel*) {
+void JumpController::enter(int phase, double time) {
   phase_ = phase;
   phase_begin_ = time;
   phase_changed_ = true;
-  times_.begin[phase] = time;
+  times_.begin[static_cast<size_t>(phase)] = time;
   from_ = target_;
   from_is_world_ = is_stance(phase);
   if (from_is_world_) {
     // World-frame joints interpolate in world pitch: start from the pitch that the last
     // commanded joint target implies for the tracked link in the current pose.
-    for (size_t i = 0; i < body_.joints.size(); ++i) {
-      from_[i] = to_world(body_.joints[i].type, static_cast<int>(i), q_, target_[i]);
-    }
+    for (size_t i = 0; i < body_.joints.size(); ++i) from_[i] = to_world(static_cast<int>(i), q_, target_[i]);
   }
   switch (phase) {
     case kCrouch: phase_duration_ = crouch_duration_; break;
@@ -171,68 +273,63 @@ void JumpController::enter(int phase, double time, mjModel*) {
   }
 }
 
-// Joint target (rad) that makes joint i's tracked link reach world pitch `world`, for
+// World pitch (rad) of joint j's parent link.
+double JumpController::parent_pitch(int j, const double* q) const {
+  return body_.child_pitch(q, j) - q[body_.joints[static_cast<size_t>(j)].qpos];
+}
+
+// Joint target (rad) that makes joint j's tracked link reach world pitch `world`, for
 // the world-frame joints of stance phases; other joints pass through.
-double JumpController::to_local(int type, int i, const double* q, double world) const {
-  const PlanarJoint& j = body_.joints[i];
-  switch (type) {
-    case kHip:  // pelvis world pitch; the pelvis is the hip's parent
-      return q[j.qpos] + wrap(q[body_.root_pitch_qpos] - world);
-    case kAnkle: {  // foot world pitch; the foot is the ankle's child
-      const int side = (i == body_.by_type[kAnkle][0]) ? 0 : 1;
-      return wrap(world - body_.child_pitch(q, body_.by_type[kKnee][side]));
-    }
-    case kWaistUpper:  // chest world pitch; the chest is the upper waist's child
-      return wrap(world - body_.child_pitch(q, body_.by_type[kWaistLower][0]));
+double JumpController::to_local(int j, const double* q, double world) const {
+  const CharacterJoint& joint = body_.joints[static_cast<size_t>(j)];
+  switch (tracked_[static_cast<size_t>(j)]) {
+    case Tracked::kParent:  // the pelvis: turning the hip turns the parent the other way
+      return q[joint.qpos] + wrap(parent_pitch(j, q) - world);
+    case Tracked::kChild:  // the foot, the chest
+      return wrap(world - parent_pitch(j, q));
     default:
       return world;
   }
 }
 
 // Inverse of to_local: the world pitch a joint target implies in the current pose.
-double JumpController::to_world(int type, int i, const double* q, double local) const {
-  const PlanarJoint& j = body_.joints[i];
-  switch (type) {
-    case kHip:
-      return q[body_.root_pitch_qpos] - (local - q[j.qpos]);
-    case kAnkle: {
-      const int side = (i == body_.by_type[kAnkle][0]) ? 0 : 1;
-      return local + body_.child_pitch(q, body_.by_type[kKnee][side]);
-    }
-    case kWaistUpper:
-      return local + body_.child_pitch(q, body_.by_type[kWaistLower][0]);
-    default:
-      return local;
+double JumpController::to_world(int j, const double* q, double local) const {
+  const CharacterJoint& joint = body_.joints[static_cast<size_t>(j)];
+  switch (tracked_[static_cast<size_t>(j)]) {
+    case Tracked::kParent: return parent_pitch(j, q) - (local - q[joint.qpos]);
+    case Tracked::kChild: return local + parent_pitch(j, q);
+    default: return local;
   }
 }
 
-double JumpController::landing_hip_goal(int i, const mjData* d) const {
-  const PlanarJoint& hip = body_.joints[i];
-  const int side = (i == body_.by_type[kHip][0]) ? 0 : 1;
+double JumpController::landing_hip_goal(int j, const mjData* d) const {
+  const CharacterJoint& hip = body_.joints[static_cast<size_t>(j)];
+  const int side = side_[static_cast<size_t>(j)];
   // Where the COM crosses the landing surface on its ballistic path.
-  const double z = std::max(com_[2] - config_.landing_height, 0.0);
+  const double z = std::max(com_[2] - config_.landing_height_m, 0.0);
   const double vz = com_vel_[2];
   const double t_cross = (vz + std::sqrt(vz * vz + 2 * gravity_ * z)) / gravity_;
   const double x_target =
       com_[0] + com_vel_[0] * t_cross + landing_offset_ + landing_velocity_gain_ * com_vel_[0];
   const double dx = x_target - d->xanchor[3 * hip.joint];
   // Two-link leg: ankle x offset = l1 sin(th) + l2 sin(th + qk) = R sin(th + psi).
-  const double qk = target_[body_.by_type[kKnee][side]];
-  const double a = body_.thigh_length + body_.shin_length * std::cos(qk);
-  const double b = body_.shin_length * std::sin(qk);
+  const int knee = body_.groups[static_cast<size_t>(knee_)].joints[static_cast<size_t>(side)];
+  const double qk = target_[static_cast<size_t>(knee)];
+  const double a = thigh_length_ + shin_length_ * std::cos(qk);
+  const double b = shin_length_ * std::sin(qk);
   const double thigh = std::asin(std::clamp(dx / std::hypot(a, b), -0.9, 0.9)) - std::atan2(b, a);
-  return wrap(thigh - d->qpos[body_.root_pitch_qpos]);
+  return wrap(thigh - parent_pitch(j, d->qpos));
 }
 
-void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts) {
+void JumpController::control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) {
   const double t = d->time;
   const double* q = d->qpos;
   q_ = q;
-  const int root = body_.pelvis;
+  const int root = body_.root_body;
   mj_subtreeVel(m, d);
   for (int k = 0; k < 3; ++k) {
-    com_[k] = d->subtree_com[3 * root + k];
-    com_vel_[k] = d->subtree_linvel[3 * root + k];
+    com_[static_cast<size_t>(k)] = d->subtree_com[3 * root + k];
+    com_vel_[static_cast<size_t>(k)] = d->subtree_linvel[3 * root + k];
   }
 
   // Transitions: at most one per step.
@@ -240,10 +337,10 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
   const double elapsed = t - phase_begin_;
   switch (phase_) {
     case kStart:
-      if (elapsed >= start_duration_) enter(kCrouch, t, m);
+      if (elapsed >= start_duration_) enter(kCrouch, t);
       break;
     case kCrouch:
-      if (elapsed >= crouch_duration_) enter(kExtend, t, m);
+      if (elapsed >= crouch_duration_) enter(kExtend, t);
       break;
     case kExtend:
       // Airborne: no contact for airborne_time with the COM rising (soft contacts can
@@ -251,10 +348,10 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
       if (contacts.any) free_since_ = -1;
       else if (free_since_ < 0) free_since_ = t;
       if (free_since_ >= 0 && t - free_since_ >= config_.airborne_time - 1e-9 && com_vel_[2] > 0) {
-        enter(kRise, t, m);
+        enter(kRise, t);
       } else if (elapsed >= config_.extend_timeout) {
         extend_timed_out_ = true;
-        enter(kLand, t, m);
+        enter(kLand, t);
       }
       break;
     case kRise:
@@ -262,13 +359,13 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
         // Touched down while still rising (a low, flat jump): the peak and the landing
         // coincide, a zero-length fall, so every jump has both airborne phases.
         times_.begin[kFall] = t;
-        enter(kLand, t, m);
+        enter(kLand, t);
       } else if (com_vel_[2] <= 0) {
-        enter(kFall, t, m);
+        enter(kFall, t);
       }
       break;
     case kFall:
-      if (contacts.any) enter(kLand, t, m);
+      if (contacts.any) enter(kLand, t);
       break;
     default:
       break;
@@ -280,15 +377,16 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
                        : std::clamp((t - phase_begin_) / std::max(phase_duration_, 1e-6), 0.0, 1.0);
   const bool landing = phase_ == kFall && config_.landing_control;
   for (size_t i = 0; i < body_.joints.size(); ++i) {
-    const int type = body_.joints[i].type;
-    if (landing && type == kHip) continue;  // needs this step's knee targets
-    const double goal = pose_[phase_][type];
+    const int group = body_.joints[i].group;
+    if (landing && group == hip_) continue;  // needs this step's knee targets
+    const int slot = pose_slot_[static_cast<size_t>(group)];
+    const double goal = slot >= 0 ? pose_[static_cast<size_t>(phase_)][static_cast<size_t>(slot)] : 0.0;
     if (from_is_world_) {
       // Interpolate the world pitch along the shorter way round, then turn it into a
       // joint target for the current pose.
-      const bool world = type == kHip || type == kAnkle || type == kWaistUpper;
+      const bool world = tracked_[i] != Tracked::kNone;
       const double step = world ? wrap(goal - from_[i]) : goal - from_[i];
-      target_[i] = to_local(type, static_cast<int>(i), q, from_[i] + s * step);
+      target_[i] = to_local(static_cast<int>(i), q, from_[i] + s * step);
     } else {
       target_[i] = from_[i] + s * (goal - from_[i]);
     }
@@ -296,58 +394,56 @@ void JumpController::control(mjModel* m, mjData* d, const ContactState& contacts
   if (landing) {
     const double pelvis = q[body_.root_pitch_qpos];
     const double w = std::clamp((std::cos(pelvis) - 0.5) / 0.5, 0.0, 1.0);
-    for (int i : body_.by_type[kHip]) {
-      double goal = pose_[kFall][kHip];
+    const double pose_hip = pose_[kFall][static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])];
+    for (int i : body_.groups[static_cast<size_t>(hip_)].joints) {
+      double goal = pose_hip;
       if (w > 0) goal = (1 - w) * goal + w * landing_hip_goal(i, d);
-      target_[i] = from_[i] + s * (goal - from_[i]);
+      target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + s * (goal - from_[static_cast<size_t>(i)]);
     }
   }
 
   // Balance: tau = J^T F on the stance legs.
-  std::array<double, 32> balance{};
+  std::fill(balance_.begin(), balance_.end(), 0.0);
   if (has_balance(phase_) && contacts.any) {
-    const double support =
-        0.5 * (d->geom_xpos[3 * body_.foot_geom[0]] + d->geom_xpos[3 * body_.foot_geom[1]]);
+    const int* feet = body_.feet.data();
+    const double support = 0.5 * (d->xipos[3 * feet[0]] + d->xipos[3 * feet[1]]);
     const double fx = std::clamp(config_.balance_kp * (support + balance_offset_ - com_[0]) -
                                      config_.balance_kd * com_vel_[0],
                                  -config_.balance_max_force, config_.balance_max_force);
     const double fz = config_.gravity_compensation * body_.total_mass * gravity_;
-    for (int type : {kAnkle, kKnee, kHip}) {
-      for (int i : body_.by_type[type]) {
-        const double* p = d->xanchor + 3 * body_.joints[i].joint;
+    for (int group : {ankle_, knee_, hip_}) {
+      for (int i : body_.groups[static_cast<size_t>(group)].joints) {
+        const double* p = d->xanchor + 3 * body_.joints[static_cast<size_t>(i)].joint;
         const double rx = com_[0] - p[0], rz = com_[2] - p[2];
-        balance[i] = -0.5 * (rx * fz - rz * fx);
+        balance_[static_cast<size_t>(i)] = -0.5 * (rx * fz - rz * fx);
       }
     }
   }
 
-  // PD torques, clamped; damping goes to dof_damping (implicit), the rest to ctrl.
-  // World-frame joints of stance phases damp the tracked link's world pitch rate: the
-  // joint damping -kd qdot (implicit) plus an explicit -kd * (rate of the link on the
-  // other side of the joint), with the sign that makes the sum the tracked link's rate.
+  // PD torques. The drive takes u (all but the damping) and kd, and applies
+  // u - kd qdot within the joint's limit. World-frame joints of stance phases damp the
+  // tracked link's world pitch rate: -kd qdot (the drive's damping) plus kd times the rate
+  // of the link on the other side of the joint, with the sign that makes the sum the
+  // tracked link's rate.
   const bool stance = is_stance(phase_);
   const double* v = d->qvel;
   for (size_t i = 0; i < body_.joints.size(); ++i) {
-    const PlanarJoint& j = body_.joints[i];
-    const bool phase_gain = j.type <= kAnkle;
-    const double kp = phase_gain ? kp_[phase_][j.type] : config_.kp[j.type];
-    const double kd = phase_gain ? kd_[phase_][j.type] : config_.kd[j.type];
-    const double qd = v[j.dof];
+    const CharacterJoint& j = body_.joints[i];
+    const JointGroup& group = body_.groups[static_cast<size_t>(j.group)];
+    const int gs = gain_slot_[static_cast<size_t>(j.group)];
+    const double kp = gs >= 0 ? kp_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kp;
+    const double kd = gs >= 0 ? kd_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kd;
     double world_damping = 0;
-    if (stance) {
-      const int side = (j.type == kHip || j.type == kAnkle) ? (i == static_cast<size_t>(body_.by_type[j.type][0]) ? 0 : 1) : 0;
-      if (j.type == kHip) {  // pelvis rate = -(qdot_hip) + thigh rate
-        world_damping = kd * body_.child_pitch_rate(v, body_.by_type[kHip][side]);
-      } else if (j.type == kAnkle) {  // foot rate = qdot_ankle + shin rate
-        world_damping = -kd * body_.child_pitch_rate(v, body_.by_type[kKnee][side]);
-      } else if (j.type == kWaistUpper) {  // chest rate = qdot + abdomen rate
-        world_damping = -kd * body_.child_pitch_rate(v, body_.by_type[kWaistLower][0]);
+    if (stance && tracked_[i] != Tracked::kNone) {
+      const double child_rate = body_.child_pitch_rate(v, static_cast<int>(i));
+      if (tracked_[i] == Tracked::kParent) {  // parent rate = child rate - qdot
+        world_damping = kd * child_rate;
+      } else {  // child rate = qdot + parent rate
+        world_damping = -kd * (child_rate - v[j.dof]);
       }
     }
-    double tau = kp * (target_[i] - q[j.qpos]) - kd * qd + world_damping + balance[i];
-    tau = std::clamp(tau, -j.torque_limit, j.torque_limit);
-    d->ctrl[j.actuator] = tau + kd * qd;
-    m->dof_damping[j.dof] = kd;
+    const double u = kp * (target_[i] - q[j.qpos]) + world_damping + balance_[i];
+    drive.set(static_cast<int>(i), u, kd);
   }
 }
 

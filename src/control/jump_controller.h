@@ -1,4 +1,5 @@
-// Phase-based jump controller for the planar human (paper section 6, figure 4).
+// "jump2d": the phase-based jump controller for planar characters (paper section 6,
+// figure 4), registered in control/builtin_controllers.cc.
 //
 // A finite state machine over six phases:
 //
@@ -14,45 +15,49 @@
 //           controller (below)
 //   land    stance, balance, targets interpolated over land.duration, then held
 //
-// Targets. Each phase has a target pose Omega_i for the 8 parameterized joint types
-// (hip, knee, ankle, lower and upper waist, shoulder, elbow, wrist; neck and head hold 0).
-// Left and right limbs share targets. Inside a phase the target moves linearly from the
-// target commanded when the phase began (Omega_{i-1}, as joint angles) to Omega_i over the
-// phase's known or predicted duration. In stance phases the feet, pelvis and upper torso
-// track world-frame pitches (paper section 5): the phase's hip value is the pelvis world
-// pitch, its ankle value the foot world pitch, its upper-waist value the chest world
-// pitch; each is turned into a joint target every step from the current pose. In flight
-// all targets are joint angles.
+// The character (character/character.h) needs a planar root and joint groups with the
+// roles hip, knee and ankle; any other groups (waist, shoulder, elbow, wrist, ...) are
+// driven too. Groups of role neck hold 0 with the character's default gains and are not
+// parameters; every other group has a target per phase.
+//
+// Targets. Each phase has a target pose Omega_i: one angle per parameterized group, left
+// and right sharing it. Inside a phase the target moves linearly from the target commanded
+// when the phase began (Omega_{i-1}, as joint angles) to Omega_i over the phase's known or
+// predicted duration. In stance phases the feet, pelvis and upper torso track world-frame
+// pitches (paper section 5): the hip group's value is the world pitch of the hips' parent
+// link (the pelvis), the ankle group's the world pitch of the foot, and the topmost waist
+// group's the world pitch of its child link (the chest); each is turned into a joint target
+// every step from the current pose. In flight all targets are joint angles.
 //
 // Torques. Every joint is PD-controlled, tau = kp (target - q) - kd qdot; hips, knees and
-// ankles use the phase's own gains, the other joints fixed gains. In start and land a
-// Jacobian-transpose balance controller adds joint torques tau = J^T F for a virtual
-// force F on the centre of mass (Pratt et al. 2001): F_x servos the COM over the middle
-// of the feet, F_z = M g supports the weight. J is the Jacobian of the COM position,
-// taken as a point fixed to the upper body, with respect to the ankle, knee and hip of
-// each leg when the feet are the base, so J^T F at joint j is -(c - p_j) x F (2D cross
-// product, c the COM, p_j the joint position); each leg carries half of F. The sum is
-// clamped to the joint's torque limit. No external force is ever applied: the root is
-// unactuated and all motion comes from these joint torques.
+// ankles use the phase's own gains, the other groups the character's default gains. In
+// start, crouch and land a Jacobian-transpose balance controller adds joint torques
+// tau = J^T F for a virtual force F on the centre of mass (Pratt et al. 2001): F_x servos
+// the COM over the middle of the feet, F_z = M g supports the weight. J is the Jacobian of
+// the COM position, taken as a point fixed to the upper body, with respect to the ankle,
+// knee and hip of each leg when the feet are the base, so J^T F at joint j is
+// -(c - p_j) x F (2D cross product, c the COM, p_j the joint position); each leg carries
+// half of F. No external force is ever applied: the root is unactuated and all motion
+// comes from joint torques, which the joint drive keeps within each joint's limit on the
+// net torque (physics/drive.h).
 //
 // Landing controller (paper section 6, 2D only). During fall, while the pelvis is within
 // 60 degrees of upright, the hip target places each ankle horizontally at
 // x_c + landing.offset + landing.velocity_gain * v_x, where x_c is where the COM is
 // predicted to cross the landing surface ballistically; the hip angle comes from the
-// two-link leg geometry with the knee at its phase target.
-//
-// Implementation: MuJoCo motors carry the torque and the joint's dof_damping carries kd,
-// so the Euler integrator treats the damping implicitly; the controller writes
-// ctrl = clamp(tau) + kd qdot so that motor plus damping equals the clamped torque.
+// two-link leg geometry (hip-knee and knee-ankle distances of the standing model) with
+// the knee at its phase target.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "character/planar_human.h"
+#include "character/character.h"
+#include "control/controller.h"
 #include "control/parameters.h"
 
 namespace diverse {
@@ -60,75 +65,78 @@ namespace diverse {
 enum JumpPhase : int { kStart = 0, kCrouch, kExtend, kRise, kFall, kLand, kNumJumpPhases };
 const char* jump_phase_name(int phase);  // "start", "crouch", ...
 
-// Contact between the character and the environment in the current state.
-struct ContactState {
-  bool any = false;                       // any body touches anything
-  std::array<bool, 2> foot{false, false}; // left, right foot touches something
-  bool non_foot = false;                  // a body other than the feet touches something
-};
-ContactState scan_contacts(const mjModel* m, const mjData* d, const PlanarHuman& body);
-
 // Constants that are not optimized (documented defaults; the task file may override).
-struct JumpControllerConfig {
-  // Fixed PD gains (kp Nm/rad, kd Nm s/rad) of the joint types without per-phase gains.
-  std::array<double, kNumJointTypes> kp{0, 0, 0, 800, 800, 150, 40, 15, 40, 30};
-  std::array<double, kNumJointTypes> kd{0, 0, 0, 80, 80, 15, 4, 1.5, 4, 3};
+struct JumpControllerConfig : ControllerConfig {
   double balance_kp = 1500;          // N/m, horizontal COM servo
   double balance_kd = 300;           // N s/m
   double balance_max_force = 400;    // N, clamp on |F_x|
   double gravity_compensation = 1;   // F_z = this * M g during balance
   bool landing_control = true;       // servo the feet during fall
-  double landing_height = 0;         // m, height of the surface the COM prediction uses
+  double landing_height_m = 0;       // m, height of the surface the COM prediction uses
   double extend_timeout = 0.8;       // s; an extend that never leaves the ground ends here
   double airborne_time = 0.01;       // s without contact (COM rising) that counts as take-off
+
+  std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
+  double landing_height() const override { return landing_height_m; }
 };
 
-// Times at which phases began (s, simulation time); negative if never reached.
-struct PhaseTimes {
-  std::array<double, kNumJumpPhases> begin{-1, -1, -1, -1, -1, -1};
-  double takeoff() const { return begin[kRise]; }
-  double peak() const { return begin[kFall]; }
-  double landing() const { return begin[kLand]; }
-};
-
-class JumpController {
+class JumpControllerType : public ControllerType {
  public:
-  JumpController(const PlanarHuman& body, const JumpControllerConfig& config);
+  const char* name() const override { return "jump2d"; }
+  const char* description() const override {
+    return "phase-based jump of a planar character (start, crouch, extend, rise, fall, land)";
+  }
+  std::shared_ptr<const ControllerConfig> read_config(const TomlReader& r) const override;
+  void check(const Character& body, const std::string& task_file) const override;
+  std::vector<ParamSpec> parameter_specs(const Character& body,
+                                         const ControllerConfig& config) const override;
+  std::unique_ptr<Controller> make(const Character& body, const ControllerConfig& config,
+                                   const std::vector<double>& values) const override;
+};
 
-  // The free parameters, their ranges and units (90 of them; see the .cc for the list).
-  static const std::vector<ParamSpec>& parameter_specs();
+class JumpController : public Controller {
+ public:
+  JumpController(const Character& body, const JumpControllerConfig& config);
 
+  // The free parameters for `body`: per phase a target per parameterized group and kp, kd
+  // of hips, knees and ankles; then durations and the landing and balance offsets (90 for
+  // the planar human).
+  static std::vector<ParamSpec> parameter_specs(const Character& body);
   // Values in parameter_specs() order.
   void set_parameters(const std::vector<double>& values);
 
-  // Starts the state machine at `start` from the state in d (after mj_step1 or
-  // mj_forward), and writes every controlled joint's damping into m.
-  void reset(mjModel* m, const mjData* d);
-  // One control step from the current state (after mj_step1): transitions, then
-  // targets, then torques into d->ctrl and kd into m->dof_damping.
-  void control(mjModel* m, mjData* d, const ContactState& contacts);
+  void reset(const mjModel* m, const mjData* d) override;
+  void control(const mjModel* m, mjData* d, const ContactState& contacts,
+               JointDrive& drive) override;
 
-  int phase() const { return phase_; }
-  bool phase_changed() const { return phase_changed_; }  // in the last control()
-  const PhaseTimes& phase_times() const { return times_; }
-  bool extend_timed_out() const { return extend_timed_out_; }
-  // COM (m) and its velocity (m/s) seen by the last control() step.
-  const std::array<double, 3>& com() const { return com_; }
-  const std::array<double, 3>& com_velocity() const { return com_vel_; }
-  const std::vector<int>& damped_dofs() const { return damped_dofs_; }
-  // Joint targets (rad) commanded in the last step, one per joint of PlanarHuman.
+  int phase() const override { return phase_; }
+  bool phase_changed() const override { return phase_changed_; }
+  const PhaseTimes& phase_times() const override { return times_; }
+  bool gave_up() const override { return extend_timed_out_; }
+  const std::array<double, 3>& com() const override { return com_; }
+  const std::array<double, 3>& com_velocity() const override { return com_vel_; }
+  // Joint targets (rad) commanded in the last step, one per Character::joints entry.
   const std::vector<double>& targets() const { return target_; }
 
  private:
-  void enter(int phase, double time, mjModel* m);
-  double to_local(int type, int joint_index, const double* qpos, double world) const;
-  double to_world(int type, int joint_index, const double* qpos, double local) const;
-  double landing_hip_goal(int joint_index, const mjData* d) const;
+  enum class Tracked { kNone, kParent, kChild };  // world-pitch tracking in stance
+  void enter(int phase, double time);
+  double parent_pitch(int j, const double* qpos) const;
+  double to_local(int j, const double* qpos, double world) const;
+  double to_world(int j, const double* qpos, double local) const;
+  double landing_hip_goal(int j, const mjData* d) const;
 
-  const PlanarHuman& body_;
+  const Character& body_;
   JumpControllerConfig config_;
-  // Parameters unpacked: pose[phase][type], gains, durations.
-  std::array<std::array<double, kNumJointTypes>, kNumJumpPhases> pose_{};
+  int hip_ = -1, knee_ = -1, ankle_ = -1, chest_ = -1;  // group indices
+  std::vector<int> posed_;         // the parameterized groups, in parameter order
+  std::vector<int> pose_slot_;     // per group: index into posed_, or -1 (holds 0)
+  std::vector<int> gain_slot_;     // per group: 0 hip, 1 knee, 2 ankle, -1 default gains
+  std::vector<Tracked> tracked_;   // per joint, in stance phases
+  std::vector<int> side_;          // per joint: 0 left or centre, 1 right
+  double thigh_length_ = 0, shin_length_ = 0;  // m, hip-knee and knee-ankle at qpos0
+  // Parameters unpacked.
+  std::array<std::vector<double>, kNumJumpPhases> pose_{};  // per phase, per posed_ entry
   std::array<std::array<double, 3>, kNumJumpPhases> kp_{}, kd_{};  // hip, knee, ankle
   double start_duration_ = 0.2, crouch_duration_ = 0.4, land_duration_ = 0.3;
   double landing_offset_ = 0, landing_velocity_gain_ = 0, balance_offset_ = 0;
@@ -141,12 +149,12 @@ class JumpController {
   double free_since_ = -1;  // time contact was last lost during extend (s), -1 if touching
   PhaseTimes times_;
   // Per joint: target at the start of the phase (rad); in stance phases the world pitch
-  // of the tracked link for the world-frame joints (hip, ankle, upper waist).
+  // of the tracked link for the world-frame joints.
   std::vector<double> from_;
   bool from_is_world_ = false;
   const double* q_ = nullptr;   // qpos of the current step
   std::vector<double> target_;  // per joint: last commanded target (rad)
-  std::vector<int> damped_dofs_;
+  std::vector<double> balance_; // per joint: J^T F of this step (Nm)
   std::array<double, 3> com_{}, com_vel_{};
   double gravity_ = 9.81;
 };

@@ -103,6 +103,42 @@ class TomlReader {
     if (!n->is_table()) fail(key, "expected a table");
     return n->as_table();
   }
+  // An array of strings (`min` entries at least).
+  std::vector<std::string> strings(const char* key, size_t min = 0) const {
+    const toml::node* n = table_.get(key);
+    const std::string expect = "expected an array of strings";
+    if (n == nullptr) fail(key, expect + " (missing)");
+    const toml::array* a = n->as_array();
+    if (a == nullptr) fail(key, expect);
+    std::vector<std::string> out;
+    for (const toml::node& e : *a) {
+      auto s = e.as_string();
+      if (!s) fail(key, expect);
+      out.push_back(s->get());
+    }
+    if (out.size() < min) fail(key, expect + " with at least " + std::to_string(min) + " entries");
+    return out;
+  }
+  // An array of tables ([[key]]); empty when the key is absent and not required.
+  std::vector<const toml::table*> tables(const char* key, bool required) const {
+    const toml::node* n = table_.get(key);
+    std::vector<const toml::table*> out;
+    if (n == nullptr) {
+      if (required) fail(key, "expected an array of tables ([[" + field(key) + "]]) (missing)");
+      return out;
+    }
+    const toml::array* a = n->as_array();
+    if (a == nullptr) fail(key, "expected an array of tables ([[" + field(key) + "]])");
+    for (const toml::node& e : *a) {
+      if (!e.is_table()) fail(key, "expected an array of tables ([[" + field(key) + "]])");
+      out.push_back(e.as_table());
+    }
+    return out;
+  }
+  // A reader of entry `index` of an array of tables, named "key[index]" in messages.
+  TomlReader element(const char* key, size_t index, const toml::table& t) const {
+    return TomlReader(file_, t, field(key) + "[" + std::to_string(index) + "]");
+  }
   TomlReader sub(const char* key, const toml::table& t) const { return TomlReader(file_, t, field(key)); }
   const toml::table& raw() const { return table_; }
   const std::string& file() const { return file_; }
@@ -112,5 +148,20 @@ class TomlReader {
   const toml::table& table_;
   std::string path_;
 };
+
+// Parses a TOML file; UserError "PATH: cannot read the WHAT file" or "PATH: line N:
+// expected valid TOML (...)".
+inline toml::table parse_toml_file(const std::string& path, const std::string& what) {
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::string description(e.description());
+    if (e.source().begin.line == 0) throw UserError(path + ": cannot read the " + what + " file");
+    throw UserError(path + ": line " + std::to_string(e.source().begin.line) +
+                    ": expected valid TOML (" + description + ")");
+  }
+  return root;
+}
 
 }  // namespace diverse

@@ -8,17 +8,18 @@
 namespace diverse {
 
 MetricLayout MotionProblem::layout_for(const TaskEvaluator& evaluator) {
+  // Hands, feet and WJA weights come from the character file (character/character.h).
+  const Character& body = evaluator.body();
   MetricLayout layout;
-  const std::vector<std::string> links = evaluator.link_names();
-  for (int i = 0; i < static_cast<int>(links.size()); ++i)
-    if (links[i].rfind("hand", 0) == 0 || links[i].rfind("foot", 0) == 0)
-      layout.hand_foot_links.push_back(i);
-  if (layout.hand_foot_links.size() != 4)
-    throw std::logic_error("MotionProblem: expected two hands and two feet among the links");
-  const std::vector<std::string> angles = evaluator.angle_names();
-  layout.angle_weights.resize(static_cast<Eigen::Index>(angles.size()));
-  for (std::size_t i = 0; i < angles.size(); ++i)
-    layout.angle_weights[static_cast<Eigen::Index>(i)] = lee2002_joint_weight(angles[i]);
+  for (std::size_t i = 0; i < body.links.size(); ++i) {
+    const int link = body.links[i];
+    const bool hand = std::find(body.hands.begin(), body.hands.end(), link) != body.hands.end();
+    if (hand || link == body.feet[0] || link == body.feet[1]) layout.hand_foot_links.push_back(static_cast<int>(i));
+  }
+  layout.angle_weights.resize(static_cast<Eigen::Index>(body.joints.size()));
+  for (std::size_t i = 0; i < body.joints.size(); ++i)
+    layout.angle_weights[static_cast<Eigen::Index>(i)] = body.groups[static_cast<std::size_t>(body.joints[i].group)].wja;
+  layout.root_weight = body.spec->root_wja;
   return layout;  // shape_weights empty: w_i = 1 (paper section 4.2)
 }
 
@@ -118,7 +119,7 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
   if (!outcome->failed) {
     outcome->features.poses.reserve(e.poses.size());
     for (const PoseSample& sample : e.poses)
-      outcome->features.poses.push_back(make_pose(sample.link_com, link_mass_, sample.angles));
+      outcome->features.poses.push_back(make_pose(sample.link_com, link_mass_, sample.angles, sample.root));
   }
   return outcome;
 }

@@ -64,8 +64,8 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
   j["summary"] = summary_json(e.summary);
 
   nlohmann::json phases = nlohmann::json::array();
-  for (int p = 0; p < kNumJumpPhases; ++p)
-    phases.push_back({{"name", jump_phase_name(p)}, {"begin", e.phases.begin[static_cast<std::size_t>(p)]}});
+  for (std::size_t p = 0; p < e.phases.names.size(); ++p)
+    phases.push_back({{"name", e.phases.names[p]}, {"begin", e.phases.begin[p]}});
   j["phases"] = phases;
 
   nlohmann::json samples = nlohmann::json::array();

@@ -27,8 +27,8 @@ FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
     columns.names.push_back(name);
     columns.frames.push_back(t < 0 ? std::vector<double>() : frame_at(t));
   };
-  add("crouch", p.begin[kCrouch]);
-  add("extend", p.begin[kExtend]);
+  // The stance phases between the start and take-off (a jump's crouch and extend).
+  for (int phase = 1; phase < p.rise; ++phase) add(p.names[static_cast<size_t>(phase)], p.at(phase));
   add("take-off", p.takeoff());
   add("rising", p.takeoff() >= 0 && p.peak() >= 0 ? 0.5 * (p.takeoff() + p.peak()) : -1);
   add("peak", p.peak());

@@ -14,22 +14,25 @@ namespace {
 // Drives the controller and watches the motion until its outcome is decided.
 class JumpHooks : public StepHooks {
  public:
-  JumpHooks(const Task& task, const PlanarHuman& body, JumpController& controller,
+  JumpHooks(const Task& task, const Character& body, Controller& controller, JointDrive& drive,
             int obstacle_geom, Evaluation& out)
-      : task_(task), body_(body), controller_(controller), obstacle_(obstacle_geom), out_(out) {
+      : task_(task), body_(body), controller_(controller), drive_(drive), obstacle_(obstacle_geom),
+        out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
+        land_(controller.phase_times().land) {
     out_.summary.min_clearance = task.simulation.clearance_range;
   }
 
   void control(mjModel* m, mjData* d) override {
     contacts_ = scan_contacts(m, d, body_);
     if (first_) controller_.reset(m, d);
-    controller_.control(m, d, contacts_);
+    controller_.control(m, d, contacts_, drive_);
   }
 
   bool observe(const mjModel* m, const mjData* d) override {
     MotionSummary& s = out_.summary;
     const double t = d->time;
-    const double pitch = d->qpos[body_.root_pitch_qpos];
+    const double pitch = root_pitch(m, d);
+    last_pitch_ = pitch;
     const int phase = controller_.phase();
     const bool changed = controller_.phase_changed();
     if (first_) {
@@ -39,18 +42,18 @@ class JumpHooks : public StepHooks {
     const double com_z = controller_.com()[2];
 
     // Events.
-    if (phase == kRise && changed) {
+    if (phase == rise_ && changed) {
       s.took_off = true;
       pitch_takeoff_ = pitch;
     }
-    const bool airborne = phase == kRise || phase == kFall;
-    if (airborne || (phase == kLand && changed && s.took_off)) {
+    const bool airborne = phase == rise_ || phase == fall_;
+    if (airborne || (phase == land_ && changed && s.took_off)) {
       out_.flight_time.push_back(t);
       out_.flight_qpos.insert(out_.flight_qpos.end(), d->qpos, d->qpos + m->nq);
     }
     if (airborne) s.peak_com_z = std::max(s.peak_com_z, com_z);
-    if (phase == kLand && changed) {
-      if (!s.took_off || controller_.extend_timed_out()) return fall(t, "never left the ground", d);
+    if (phase == land_ && changed) {
+      if (!s.took_off || controller_.gave_up()) return fall(t, "never left the ground", d);
       s.landed = true;
       s.rotation_flight = pitch - pitch_takeoff_;
       s.touchdown_feet_x = feet_mean(d, 0);
@@ -70,8 +73,7 @@ class JumpHooks : public StepHooks {
     // Falls.
     if (contacts_.non_foot) return fall(t, "a body other than the feet touched the ground or an object", d);
     if (!airborne) {
-      const double feet_z = 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + 2] +
-                                   d->geom_xpos[3 * body_.foot_geom[1] + 2]);
+      const double feet_z = feet_mean(d, 2);
       if (com_z - feet_z < task_.simulation.fall_com_height) {
         return fall(t, "the centre of mass dropped to the feet", d);
       }
@@ -95,18 +97,34 @@ class JumpHooks : public StepHooks {
   }
 
  private:
+  // How far the motion got: the phase reached, then the time at rest after landing.
   double progress(double t) const {
     const int phase = controller_.phase();
-    if (phase == kLand && out_.summary.landed) {
+    const double phases = static_cast<double>(controller_.phase_times().begin.size());
+    if (phase == land_ && out_.summary.landed) {
       const double since = t - controller_.phase_times().landing();
-      return (5 + std::min(1.0, since / task_.simulation.settle_time)) / static_cast<double>(kNumJumpPhases);
+      return (land_ + std::min(1.0, since / task_.simulation.settle_time)) / phases;
     }
-    return static_cast<double>(std::min(phase, 5)) / static_cast<double>(kNumJumpPhases);
+    return static_cast<double>(std::min(phase, land_)) / phases;
   }
 
-  // Mean over the two foot centres of world coordinate `axis` (0 = x, 2 = z).
+  // Mean over the two feet's centres of mass of world coordinate `axis` (0 = x, 2 = z).
   double feet_mean(const mjData* d, int axis) const {
-    return 0.5 * (d->geom_xpos[3 * body_.foot_geom[0] + axis] + d->geom_xpos[3 * body_.foot_geom[1] + axis]);
+    return 0.5 * (d->xipos[3 * body_.feet[0] + axis] + d->xipos[3 * body_.feet[1] + axis]);
+  }
+
+  // The root's pitch (rad, positive backwards), unwrapped over the motion: the planar
+  // root's hinge angle, or for a free root the integral of its world angular velocity
+  // about -y (a full backward turn gives 2 pi).
+  double root_pitch(const mjModel* m, const mjData* d) {
+    if (body_.root == RootKind::kPlanar) return d->qpos[body_.root_pitch_qpos];
+    if (!first_) {
+      const double* w = d->qvel + body_.root_dof + 3;  // body frame
+      const double* R = d->xmat + 9 * body_.root_body;
+      const double wy = R[3] * w[0] + R[4] * w[1] + R[5] * w[2];
+      free_pitch_ += -wy * m->opt.timestep;
+    }
+    return free_pitch_;
   }
 
   bool fall(double t, const char* why, const mjData* d) {
@@ -126,32 +144,35 @@ class JumpHooks : public StepHooks {
       s.touchdown_feet_x = s.feet_x;
       s.touchdown_feet_z = s.feet_z;
     }
-    s.rotation_total = d->qpos[body_.root_pitch_qpos] - pitch0_;
+    s.rotation_total = last_pitch_ - pitch0_;
     return true;
   }
 
   const Task& task_;
-  const PlanarHuman& body_;
-  JumpController& controller_;
+  const Character& body_;
+  Controller& controller_;
+  JointDrive& drive_;
   int obstacle_;
   Evaluation& out_;
+  const int rise_, fall_, land_;  // the controller's airborne phases and landing
   ContactState contacts_;
   bool first_ = true;
-  double pitch0_ = 0, pitch_takeoff_ = 0;
+  double pitch0_ = 0, pitch_takeoff_ = 0, last_pitch_ = 0, free_pitch_ = 0;
 };
 
 }  // namespace
 
 TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
-  model_ = SharedModel::from_xml(scene_xml(task_), task_.character);
-  body_ = std::make_unique<PlanarHuman>(model_->get(), task_.character);
+  model_ = SharedModel::from_xml(scene_xml(task_), task_.model);
+  body_ = std::make_unique<Character>(bind_character(task_.character_spec, model_->get(), task_.model));
+  task_.controller_type->check(*body_, task_.file);
   if (task_.constraints.clearance) {
     obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());
   }
 }
 
 ParameterSet TaskEvaluator::parameters() const {
-  const auto& specs = JumpController::parameter_specs();
+  const auto specs = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   std::vector<double> values;
   for (const ParamSpec& s : specs) values.push_back(s.lower);
   return ParameterSet(specs, values);
@@ -214,19 +235,19 @@ Evaluation TaskEvaluator::evaluate(const std::vector<double>& values, SimWorker&
   return evaluate_on(values, *body_, worker, options);
 }
 
-Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const PlanarHuman& body,
+Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const Character& body,
                                       SimWorker& worker, const EvaluationOptions& options) const {
   Evaluation e;
   worker.reset();
   mjModel* m = worker.model();
-  JumpController controller(body, task_.controller_config);
-  controller.set_parameters(values);
+  const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
+  JointDrive drive = make_drive(body);
   e.flight_time.reserve(1024);
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
-  JumpHooks hooks(task_, body, controller, obstacle_geom_, e);
+  JumpHooks hooks(task_, body, *controller, drive, obstacle_geom_, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
-  e.stats = run_rollout(worker, hooks, max_steps, controller.damped_dofs(), options.recorder);
-  e.phases = controller.phase_times();
+  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  e.phases = controller->phase_times();
   if (e.stats.unstable) {
     e.failed = true;
     e.failure = "simulation unstable: " + e.stats.instability;
@@ -256,7 +277,7 @@ bool holds_shape(const ParameterSet& params) {
 
 const ShapeSpace& TaskEvaluator::shapes() const {
   std::call_once(shapes_->once, [this] {
-    shapes_->space = std::make_unique<ShapeSpace>(model_->xml(), task_.character);
+    shapes_->space = std::make_unique<ShapeSpace>(model_->xml(), task_.model);
   });
   return *shapes_->space;
 }
@@ -274,7 +295,7 @@ ParameterSet TaskEvaluator::with_shape(const ParameterSet& control, const Eigen:
 }
 
 std::vector<double> TaskEvaluator::control_values(const ParameterSet& params) const {
-  const auto& specs = JumpController::parameter_specs();
+  const auto specs = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   std::vector<double> values;
   values.reserve(specs.size());
   for (const ParamSpec& s : specs) values.push_back(params.get(s.name));
@@ -320,7 +341,7 @@ std::shared_ptr<const ShapedScene> TaskEvaluator::shaped_scene(const Eigen::Vect
   scene->model = space.compile(scales, origin);  // validates
   scene->link_lengths = space.link_lengths(scales);
   scene->standing = space.standing(scales);
-  scene->body = std::make_shared<const PlanarHuman>(scene->model->get(), origin);
+  scene->body = std::make_shared<const Character>(bind_character(task_.character_spec, scene->model->get(), origin));
   return scene;
 }
 
@@ -376,7 +397,8 @@ std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int pha
   std::vector<PoseSample> out;
   for (double tau : taus) {
     const double t = a + std::clamp(tau, 0.0, 1.0) * (b - a);
-    // Bracketing recorded states; linear interpolation (all joints are hinges or slides).
+    // Bracketing recorded states; linear interpolation (hinges and slides; a free root's
+    // quaternion is interpolated linearly and normalized, exact enough between two steps).
     const auto& ts = e.flight_time;
     size_t hi = std::lower_bound(ts.begin(), ts.end(), t) - ts.begin();
     hi = std::min(hi, ts.size() - 1);
@@ -385,6 +407,7 @@ std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int pha
     for (int i = 0; i < nq; ++i) {
       d->qpos[i] = (1 - w) * e.flight_qpos[lo * nq + i] + w * e.flight_qpos[hi * nq + i];
     }
+    if (body_->root == RootKind::kFree) mju_normalize4(d->qpos + body_->root_qpos + 3);
     mj_kinematics(m, d);
     PoseSample p;
     p.phase = phase;
@@ -394,9 +417,9 @@ std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int pha
     for (size_t k = 0; k < body_->links.size(); ++k) {
       for (int c = 0; c < 3; ++c) p.link_com(c, static_cast<int>(k)) = d->xipos[3 * body_->links[k] + c];
     }
-    p.angles.resize(static_cast<int>(body_->joints.size()) + 1);
+    p.angles.resize(static_cast<int>(body_->joints.size()));
     for (size_t k = 0; k < body_->joints.size(); ++k) p.angles[static_cast<int>(k)] = d->qpos[body_->joints[k].qpos];
-    p.angles[static_cast<int>(body_->joints.size())] = d->qpos[body_->root_pitch_qpos];
+    p.root = root_orientation(*body_, d->qpos);
     out.push_back(std::move(p));
   }
   return out;
@@ -416,9 +439,17 @@ std::vector<std::string> TaskEvaluator::link_names() const {
 
 std::vector<std::string> TaskEvaluator::angle_names() const {
   std::vector<std::string> names;
-  for (const PlanarJoint& j : body_->joints) names.push_back(j.name);
-  names.push_back("root");
+  for (const CharacterJoint& j : body_->joints) names.push_back(j.name);
   return names;
+}
+
+Eigen::Quaterniond root_orientation(const Character& body, const double* qpos) {
+  if (body.root == RootKind::kPlanar) {
+    // Every planar hinge turns about -y.
+    return Eigen::Quaterniond(Eigen::AngleAxisd(qpos[body.root_pitch_qpos], -Eigen::Vector3d::UnitY()));
+  }
+  const double* q = qpos + body.root_qpos + 3;  // w x y z
+  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
 }
 
 }  // namespace diverse

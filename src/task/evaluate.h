@@ -1,7 +1,8 @@
 // Evaluating a task: one controller parameter vector in, one simulated motion out.
 //
 // TaskEvaluator holds what every evaluation of a task shares, read-only: the compiled
-// scene (character plus objects), the character map and the task. Each thread owns a
+// scene (character plus objects), the character bound to it (character/character.h), the
+// task and its controller plug-in (control/controller.h). Each thread owns a
 // SimWorker (private model copy + mjData, from make_worker()) and passes it in, so
 // evaluate() is thread-safe and a pure function of the parameters: the same vector gives
 // the same result bit for bit on any worker.
@@ -22,9 +23,9 @@
 #include <string>
 #include <vector>
 
-#include "character/planar_human.h"
+#include "character/character.h"
 #include "character/shape.h"
-#include "control/jump_controller.h"
+#include "control/controller.h"
 #include "control/parameters.h"
 #include "physics/model.h"
 #include "physics/rollout.h"
@@ -38,8 +39,9 @@ struct PoseSample {
   int phase = 0;            // 0: take-off to peak, 1: peak to landing
   double phase_time = 0;    // phase-normalized time in [0, 1]
   double time = 0;          // s
-  Eigen::Matrix3Xd link_com;  // world COM of each link (m), PlanarHuman::links order
-  Eigen::VectorXd angles;     // the 16 joint angles (PlanarHuman::joints order), then root pitch (rad)
+  Eigen::Matrix3Xd link_com;  // world COM of each link (m), Character::links order
+  Eigen::VectorXd angles;     // the joint angles (Character::joints order, rad)
+  Eigen::Quaterniond root = Eigen::Quaterniond::Identity();  // root orientation in the world
 };
 
 struct EvaluationOptions {
@@ -66,13 +68,17 @@ struct Evaluation {
 // threads share it, each with its own SimWorker on `model`.
 struct ShapedScene {
   Eigen::VectorXd scales;                    // the 10 scales, ShapeSpace order
-  Eigen::VectorXd link_lengths;              // m, one per link, PlanarHuman::links order
+  Eigen::VectorXd link_lengths;              // m, one per link, ShapeSpace::link_names() order
   StandingShape standing;                    // start height and ground clearance
   std::shared_ptr<const SharedModel> model;  // the shaped scene; model->xml() is its exact text
-  std::shared_ptr<const PlanarHuman> body;   // the character map of `model`
+  std::shared_ptr<const Character> body;     // the character bound to `model`
   // A hand or arm starts below the lowest point of the feet: the body cannot stand.
   bool below_floor() const { return standing.lowest_other_z < standing.feet_z; }
 };
+
+// The root's orientation in the world for a state: a planar root's pitch about -y, or a
+// free root's quaternion.
+Eigen::Quaterniond root_orientation(const Character& body, const double* qpos);
 
 // True when a parameter set holds shape scales ("shape.*" names, ShapeSpace::specs()).
 bool holds_shape(const ParameterSet& params);
@@ -84,7 +90,7 @@ class TaskEvaluator {
   const Task& task() const { return task_; }
   const SharedModel& model() const { return *model_; }
   const std::shared_ptr<const SharedModel>& model_ptr() const { return model_; }
-  const PlanarHuman& body() const { return *body_; }
+  const Character& body() const { return *body_; }
 
   // The controller's parameters (names, ranges) with all values at their lower bound.
   ParameterSet parameters() const;
@@ -140,16 +146,16 @@ class TaskEvaluator {
   // Link masses (kg) and joint names in PoseSample order.
   Eigen::VectorXd link_masses() const;
   std::vector<std::string> link_names() const;
-  std::vector<std::string> angle_names() const;  // 16 joints, then "root"
+  std::vector<std::string> angle_names() const;  // the joints (Character::joints order)
 
  private:
   Task task_;
   std::shared_ptr<const SharedModel> model_;
-  std::unique_ptr<PlanarHuman> body_;
+  std::unique_ptr<Character> body_;
   int obstacle_geom_ = -1;
 
   // The rollout of evaluate(), on `body` (the task's, or a shaped scene's).
-  Evaluation evaluate_on(const std::vector<double>& values, const PlanarHuman& body,
+  Evaluation evaluate_on(const std::vector<double>& values, const Character& body,
                          SimWorker& worker, const EvaluationOptions& options) const;
   struct Shapes {
     std::once_flag once;

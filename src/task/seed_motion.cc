@@ -155,8 +155,8 @@ Task with_height(const Task& task, double height) {
   Task t = task;
   for (SceneObject& o : t.objects) {
     if (o.name != task.seed.object) continue;
-    if (o.kind == "box" && task.controller_config.landing_height == o.height) {
-      t.controller_config.landing_height = height;
+    if (o.kind == "box" && task.controller_config->landing_height() == o.height) {
+      t.controller_config = t.controller_config->with_landing_height(height);
     }
     o.height = height;
   }

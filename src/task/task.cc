@@ -30,18 +30,9 @@ std::string existing_file(const TomlReader& r, const char* key) {
 }
 
 void read_controller(const TomlReader& r, Task& task) {
-  r.only({"type", "landing_control", "landing_height", "extend_timeout", "balance_kp",
-          "balance_kd", "balance_max_force", "gravity_compensation"});
   task.controller = r.string("type");
-  if (task.controller != "jump2d") r.fail("type", "expected \"jump2d\", got \"" + task.controller + "\"");
-  JumpControllerConfig& c = task.controller_config;
-  c.landing_control = r.boolean("landing_control", c.landing_control);
-  c.landing_height = r.number("landing_height", 0, 3, c.landing_height);
-  c.extend_timeout = r.number("extend_timeout", 0.1, 3, c.extend_timeout);
-  c.balance_kp = r.number("balance_kp", 0, 10000, c.balance_kp);
-  c.balance_kd = r.number("balance_kd", 0, 5000, c.balance_kd);
-  c.balance_max_force = r.number("balance_max_force", 0, 5000, c.balance_max_force);
-  c.gravity_compensation = r.number("gravity_compensation", 0, 2, c.gravity_compensation);
+  task.controller_type = &find_controller(task.controller, r.file() + ": " + r.field("type"));
+  task.controller_config = task.controller_type->read_config(r);
 }
 
 void read_objects(const TomlReader& r, const toml::node* node, Task& task) {
@@ -206,7 +197,9 @@ Task load_task(const std::string& path) {
   task.name = r.string("name");
   if (task.name.empty()) r.fail("name", "expected a non-empty string");
   task.description = r.string("description", "");
-  task.character = existing_file(r, "character");
+  task.character = resolve_character_file(existing_file(r, "character"));
+  task.character_spec = std::make_shared<const CharacterSpec>(load_character_file(task.character));
+  task.model = task.character_spec->model;
   task.metric = r.string("metric");
   if (task.metric != "hf" && task.metric != "md" && task.metric != "wja") {
     r.fail("metric", "expected \"hf\", \"md\" or \"wja\", got \"" + task.metric + "\"");
@@ -233,8 +226,8 @@ std::string resolve_task_path(const std::string& name_or_path) {
 }
 
 std::string scene_xml(const Task& task) {
-  std::ifstream in(task.character, std::ios::binary);
-  if (!in) throw UserError(task.character + ": cannot read the model file");
+  std::ifstream in(task.model, std::ios::binary);
+  if (!in) throw UserError(task.model + ": cannot read the model file");
   std::stringstream buffer;
   buffer << in.rdbuf();
   std::string xml = buffer.str();
@@ -255,7 +248,7 @@ std::string scene_xml(const Task& task) {
   }
   const size_t at = xml.rfind("</worldbody>");
   if (at == std::string::npos) {
-    throw UserError(task.character + ": expected a <worldbody> element in the model");
+    throw UserError(task.model + ": expected a <worldbody> element in the model");
   }
   xml.insert(at, geoms.str());
   if (task.simulation.timestep > 0) {

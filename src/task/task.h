@@ -1,6 +1,7 @@
 // Task files: what a skill must achieve, with which character and controller.
 //
-// A task is a TOML file (tasks/<name>.toml) naming the character model, the controller
+// A task is a TOML file (tasks/<name>.toml) naming the character (its character file, or
+// an MJCF with its character file beside it), the controller (a plug-in, control/controller.h)
 // and its constants, scene objects, the constraints of paper section 7.1 (SPEC 5) with
 // their parameters and penalties (SPEC 2.4), the paper's distance metric, the default
 // number of variations N, where the input motion M0's parameters are, and how
@@ -16,7 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "control/jump_controller.h"
+#include <memory>
+
+#include "character/character.h"
+#include "control/controller.h"
 
 namespace diverse {
 
@@ -92,9 +96,12 @@ struct Task {
   std::string file;         // the task file as given
   std::string name;
   std::string description;
-  std::string character;    // resolved model path
-  std::string controller = "jump2d";
-  JumpControllerConfig controller_config;
+  std::string character;    // resolved character file (character/character.h)
+  std::shared_ptr<const CharacterSpec> character_spec;  // that file, parsed
+  std::string model;        // resolved MJCF path of the character (character_spec->model)
+  std::string controller = "jump2d";                   // [controller] type
+  const ControllerType* controller_type = nullptr;     // its plug-in
+  std::shared_ptr<const ControllerConfig> controller_config;  // its own keys
   std::vector<SceneObject> objects;
   TaskConstraints constraints;
   TaskSimulation simulation;

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "character/planar_human.h"
+#include "character/character.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "physics/mujoco_guard.h"
@@ -23,6 +23,25 @@ namespace diverse {
 namespace {
 
 const std::string kModelPath = std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human2d.xml";
+
+// The planar human bound to a compiled model (its character file beside the MJCF).
+Character human(const mjModel* m) {
+  static const auto spec = std::make_shared<const CharacterSpec>(
+      load_character_file(std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human2d.toml"));
+  return bind_character(spec, m, "model");
+}
+int body_id(const mjModel* m, const std::string& name) { return mj_name2id(m, mjOBJ_BODY, name.c_str()); }
+// Distance (m) between two joints' anchors in the model's standing pose.
+double anchor_distance(const Character& body, const std::string& a, const std::string& b) {
+  const CharacterJoint *ja = nullptr, *jb = nullptr;
+  for (const CharacterJoint& j : body.joints) {
+    if (j.name == a) ja = &j;
+    if (j.name == b) jb = &j;
+  }
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) d2 += std::pow(ja->anchor0[k] - jb->anchor0[k], 2);
+  return std::sqrt(d2);
+}
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -76,13 +95,13 @@ struct Standing {
 Standing measure(const mjModel* m) {
   mjData* d = mj_makeData(m);
   mj_forward(m, d);
-  const PlanarHuman body(m);
+  const Character body = human(m);
   Standing s{1e9, -1e9, 1e9};
   for (int g = 0; g < m->ngeom; ++g) {
-    if (m->body_rootid[m->geom_bodyid[g]] != body.pelvis) continue;
+    if (m->body_rootid[m->geom_bodyid[g]] != body.root_body) continue;
     double low = 0, high = 0;
     geom_z_range(m, d, g, &low, &high);
-    const bool foot = g == body.foot_geom[0] || g == body.foot_geom[1];
+    const bool foot = body.is_foot_geom(m, g);
     (foot ? s.feet_low : s.other_low) = std::min(foot ? s.feet_low : s.other_low, low);
     s.top = std::max(s.top, high);
   }
@@ -138,25 +157,26 @@ TEST(Shape, LongerThighMovesKneeAndAnkleAndRaisesThePelvis) {
   auto shaped = space().compile(with(kShapeThigh, r));
   const mjModel* m = base->get();
   const mjModel* n = shaped->get();
-  const PlanarHuman body(n);
+  const Character body = human(n);
+  const int pelvis = body.root_body;
   const double added = 0.39 * (r - 1);
-  EXPECT_NEAR(n->body_pos[3 * body.pelvis + 2], m->body_pos[3 * body.pelvis + 2] + added, 1e-12);
+  EXPECT_NEAR(n->body_pos[3 * pelvis + 2], m->body_pos[3 * pelvis + 2] + added, 1e-12);
   EXPECT_NEAR(space().standing(with(kShapeThigh, r)).pelvis_z, 0.85 + added, 1e-12);
   mjData* d = mj_makeData(n);
   mj_forward(n, d);
-  for (int s = 0; s < 2; ++s) {
-    const double hip = d->xpos[3 * body.thigh[s] + 2];
-    const double knee = d->xpos[3 * body.shin[s] + 2];
-    const double ankle = d->xpos[3 * body.foot[s] + 2];
+  for (const char* side : {"_l", "_r"}) {
+    const double hip = d->xpos[3 * body_id(n, std::string("thigh") + side) + 2];
+    const double knee = d->xpos[3 * body_id(n, std::string("shin") + side) + 2];
+    const double ankle = d->xpos[3 * body_id(n, std::string("foot") + side) + 2];
     EXPECT_NEAR(hip, 0.85 + added, 1e-12);
     EXPECT_NEAR(hip - knee, 0.39 * r, 1e-12);
     EXPECT_NEAR(knee - ankle, 0.39, 1e-12);
     EXPECT_NEAR(ankle, 0.07, 1e-12);  // the feet stay on the ground
   }
   // Shoulders and head ride up by the same amount; nothing else changes length.
-  EXPECT_NEAR(d->xpos[3 * body.chest + 2], 1.10 + added, 1e-12);
-  EXPECT_DOUBLE_EQ(body.thigh_length, 0.39 * r);
-  EXPECT_DOUBLE_EQ(body.shin_length, 0.39);
+  EXPECT_NEAR(d->xpos[3 * body_id(n, "chest") + 2], 1.10 + added, 1e-12);
+  EXPECT_NEAR(anchor_distance(body, "hip_l", "knee_l"), 0.39 * r, 1e-12);
+  EXPECT_NEAR(anchor_distance(body, "knee_l", "ankle_l"), 0.39, 1e-12);
   mj_deleteData(d);
 }
 
@@ -169,7 +189,7 @@ TEST(Shape, MassesNeverChangeButInertiasFollowTheLengths) {
     auto shaped = space().compile(scales);
     const mjModel* n = shaped->get();
     EXPECT_TRUE(same(m->body_mass, n->body_mass, m->nbody));
-    EXPECT_NEAR(PlanarHuman(n).total_mass, 80.0, 1e-9);
+    EXPECT_NEAR(human(n).total_mass, 80.0, 1e-9);
     // The thigh's inertia about its hinge axis grows with its length (capsule, fixed mass).
     const int thigh = mj_name2id(n, mjOBJ_BODY, "thigh_l");
     EXPECT_EQ(n->body_inertia[3 * thigh] > m->body_inertia[3 * thigh], scales[kShapeThigh] > 1.0);
@@ -248,8 +268,8 @@ TEST(Shape, ParametersAreNamedAndRanged) {
 TEST(Shape, LinkLengthsAreTheScaledLinks) {
   auto base = SharedModel::from_file(kModelPath);
   const mjModel* m = base->get();
-  const PlanarHuman body(m);
-  // One length per link, in PlanarHuman::links (model) order.
+  const Character body = human(m);
+  // One length per link, in Character::links (model) order.
   ASSERT_EQ(space().link_names().size(), body.links.size());
   for (size_t i = 0; i < body.links.size(); ++i) {
     EXPECT_EQ(space().link_names()[i], mj_id2name(m, mjOBJ_BODY, body.links[i]));
@@ -340,15 +360,15 @@ TEST(Shape, ModelsOutsideTheShapeRulesAreRejected) {
 TEST(Shape, SceneObjectsAreCopiedThrough) {
   // A task scene is the character plus boxes: only the character changes.
   const Task task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_onto.toml");
-  const ShapeSpace scene(scene_xml(task), task.character);
+  const ShapeSpace scene(scene_xml(task), task.model);
   auto base = SharedModel::from_xml(scene_xml(task), "scene");
   auto shaped = scene.compile(with(kShapeShin, 0.8));
   const mjModel* m = base->get();
   const mjModel* n = shaped->get();
   ASSERT_EQ(m->ngeom, n->ngeom);
-  const PlanarHuman body(m);
+  const Character body = human(m);
   for (int g = 0; g < m->ngeom; ++g) {
-    if (m->body_rootid[m->geom_bodyid[g]] == body.pelvis) continue;
+    if (m->body_rootid[m->geom_bodyid[g]] == body.root_body) continue;
     EXPECT_TRUE(same(m->geom_pos + 3 * g, n->geom_pos + 3 * g, 3)) << g;
     EXPECT_TRUE(same(m->geom_size + 3 * g, n->geom_size + 3 * g, 3)) << g;
   }

@@ -2,7 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "control/jump_controller.h"
+#include "task/evaluate.h"
+#include "task/task.h"
 #include "core/error.h"
 
 namespace diverse {
@@ -11,7 +12,8 @@ namespace {
 TEST(ParameterSet, NormalizedEndpointsMapExactlyOntoTheBounds) {
   // Every controller parameter: x = 0 and x = 1 give exactly the bounds, so a vector at
   // the edge of the optimizer's box always reads back as valid parameters.
-  const auto& specs = JumpController::parameter_specs();
+  const TaskEvaluator ev(load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/backflip.toml"));
+  const auto specs = ev.parameters().specs();
   ParameterSet p(specs, std::vector<double>(specs.size(), 0.0));
   p.set_normalized(Eigen::VectorXd::Ones(p.size()));
   for (int i = 0; i < p.size(); ++i) EXPECT_EQ(p.values()[i], specs[i].upper) << specs[i].name;

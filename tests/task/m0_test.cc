@@ -36,11 +36,11 @@ SimRun simulate(const std::string& name, double timestep = 0) {
   options.recorder = &r.record;
   r.e = ev.evaluate(p.values(), *worker, options);
   // Torque limits on what was applied: motor plus joint damping, every step.
-  const PlanarHuman& body = ev.body();
+  const Character& body = ev.body();
   double worst = 0;
   for (int k = 0; k < r.record.steps(); ++k) {
     for (size_t i = 0; i < body.joints.size(); ++i) {
-      const PlanarJoint& j = body.joints[i];
+      const CharacterJoint& j = body.joints[i];
       const double tau = r.record.actuator_force[k * r.record.nu + j.actuator] +
                          r.record.damping_force[k * r.record.ndamp + static_cast<int>(i)];
       worst = std::max(worst, std::fabs(tau) / j.torque_limit);

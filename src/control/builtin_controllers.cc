@@ -1,0 +1,17 @@
+// The controller types this build knows, by the name a task file's [controller] type
+// gives. A new controller adds its line here and lives in its own files under control/.
+#include <memory>
+#include <vector>
+
+#include "control/controller.h"
+#include "control/jump_controller.h"
+
+namespace diverse {
+
+std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
+  std::vector<std::unique_ptr<ControllerType>> types;
+  types.push_back(std::make_unique<JumpControllerType>());
+  return types;
+}
+
+}  // namespace diverse

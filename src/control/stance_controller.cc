@@ -1,0 +1,450 @@
+#include "control/stance_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace diverse {
+namespace {
+
+using Vec2 = std::array<double, 2>;
+
+double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
+// Convex hull, counter-clockwise, no repeated end point (Andrew's monotone chain). Points
+// are rounded to 1 micrometre and vertices on a straight edge dropped, so a box's top and
+// bottom corners (the same points up to rounding) give one clean polygon.
+std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
+  for (Vec2& v : p) {
+    for (double& x : v) x = std::round(x * 1e6) * 1e-6;
+  }
+  std::sort(p.begin(), p.end());
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  std::vector<Vec2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross2(h[k - 2], h[k - 1], p[i]) <= 1e-10) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross2(h[k - 2], h[k - 1], p[i]) <= 1e-10) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// The convex polygon `h` (counter-clockwise) moved `margin` inward: each edge's line
+// shifted along its inward normal, consecutive lines intersected. If the polygon is too
+// small for the margin, its centroid alone.
+std::vector<Vec2> shrink(const std::vector<Vec2>& h, double margin) {
+  const size_t n = h.size();
+  Vec2 centroid{0, 0};
+  for (const Vec2& v : h) {
+    centroid[0] += v[0] / static_cast<double>(n);
+    centroid[1] += v[1] / static_cast<double>(n);
+  }
+  if (n < 3) return {centroid};
+  // Line i: points x with n_i . x = c_i, n_i the inward unit normal.
+  std::vector<Vec2> normal(n);
+  std::vector<double> offset(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec2& a = h[i];
+    const Vec2& b = h[(i + 1) % n];
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double len = std::hypot(dx, dy);
+    normal[i] = {-dy / len, dx / len};  // left of a->b: inward for counter-clockwise
+    offset[i] = normal[i][0] * a[0] + normal[i][1] * a[1] + margin;
+  }
+  std::vector<Vec2> out;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t j = (i + n - 1) % n;  // the previous edge meets edge i at vertex i
+    const double det = normal[j][0] * normal[i][1] - normal[j][1] * normal[i][0];
+    if (std::fabs(det) < 1e-12) continue;
+    out.push_back({(offset[j] * normal[i][1] - normal[j][1] * offset[i]) / det,
+                   (normal[j][0] * offset[i] - offset[j] * normal[i][0]) / det});
+  }
+  // Too small: an inverted polygon (some shifted vertex outside another shifted edge).
+  for (const Vec2& v : out) {
+    for (size_t i = 0; i < n; ++i) {
+      if (normal[i][0] * v[0] + normal[i][1] * v[1] < offset[i] - 1e-9) return {centroid};
+    }
+  }
+  return out.size() >= 3 ? out : std::vector<Vec2>{centroid};
+}
+
+// The point of the convex polygon `h` (counter-clockwise) nearest to p.
+Vec2 project(const std::vector<Vec2>& h, const Vec2& p) {
+  if (h.size() == 1) return h[0];
+  bool inside = h.size() >= 3;
+  for (size_t i = 0; i < h.size() && inside; ++i) {
+    if (cross2(h[i], h[(i + 1) % h.size()], p) < 0) inside = false;
+  }
+  if (inside) return p;
+  Vec2 best = h[0];
+  double best_d = INFINITY;
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Vec2& a = h[i];
+    const Vec2& b = h[(i + 1) % h.size()];
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2 : 0;
+    t = std::clamp(t, 0.0, 1.0);
+    const Vec2 q{a[0] + t * dx, a[1] + t * dy};
+    const double dist = std::hypot(p[0] - q[0], p[1] - q[1]);
+    if (dist < best_d) {
+      best_d = dist;
+      best = q;
+    }
+  }
+  return best;
+}
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// a . ((r) x f)
+double axis_moment(const double* a, const double* r, const double* f) {
+  double c[3];
+  mju_cross(c, r, f);
+  return dot3(a, c);
+}
+
+// Rotation vector (world frame) of the rotation that takes orientation q to `target`.
+void rotation_error(const double* target, const double* q, double* e) {
+  double inv[4], dq[4];
+  mju_negQuat(inv, q);
+  mju_mulQuat(dq, target, inv);
+  if (dq[0] < 0) {
+    for (double& v : dq) v = -v;
+  }
+  mju_quat2Vel(e, dq, 1.0);
+}
+
+// Heading (yaw about world z) of a body's x axis, from its orientation quaternion.
+double heading(const double* quat) {
+  double R[9];
+  mju_quat2Mat(R, quat);
+  return std::atan2(R[3], R[0]);
+}
+
+int depth(const mjModel* m, int body) {
+  int n = 0;
+  for (int b = body; b > 0; b = m->body_parentid[b]) ++n;
+  return n;
+}
+
+}  // namespace
+
+StanceController::StanceController(const Character& body, const mjModel* m, StanceGains gains)
+    : body_(body), gains_(gains) {
+  if (body.root != RootKind::kFree) {
+    throw std::invalid_argument("StanceController: needs a character with a free root");
+  }
+  const int n = body.dof();
+  const int root = body.root_body;
+  targets_.resize(static_cast<size_t>(n));
+  u_.assign(static_cast<size_t>(n), 0.0);
+  kd_.assign(static_cast<size_t>(n), 0.0);
+  leg_of_.assign(static_cast<size_t>(n), -1);
+  is_hip_.assign(static_cast<size_t>(n), 0);
+  is_foot_.assign(static_cast<size_t>(n), 0);
+  std::vector<int> index_of(static_cast<size_t>(m->njnt), -1);
+  for (int k = 0; k < n; ++k) {
+    const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
+    targets_[static_cast<size_t>(k)] = m->qpos0[j.qpos];
+    index_of[static_cast<size_t>(j.joint)] = k;
+    if (m->body_parentid[j.body] == root) root_children_.push_back(k);
+  }
+
+  // Legs: the hinges from each foot up to the root.
+  geom_side_.assign(static_cast<size_t>(m->ngeom), -1);
+  for (int s = 0; s < 2; ++s) {
+    const int foot = body.feet[static_cast<size_t>(s)];
+    Leg& leg = legs_[static_cast<size_t>(s)];
+    for (int b = foot; b != root && b > 0; b = m->body_parentid[b]) {
+      for (int jj = m->body_jntadr[b]; jj >= 0 && jj < m->body_jntadr[b] + m->body_jntnum[b]; ++jj) {
+        const int k = index_of[static_cast<size_t>(jj)];
+        if (k < 0) continue;
+        leg.joints.push_back(k);
+        leg_of_[static_cast<size_t>(k)] = s;
+        if (b == foot) {
+          leg.foot.push_back(k);
+          is_foot_[static_cast<size_t>(k)] = 1;
+        }
+        if (m->body_parentid[b] == root) {
+          leg.hips.push_back(k);
+          is_hip_[static_cast<size_t>(k)] = 1;
+        }
+      }
+    }
+    for (int g = 0; g < m->ngeom; ++g) {
+      for (int b = m->geom_bodyid[g]; b > 0; b = m->body_parentid[b]) {
+        if (b == foot) {
+          geom_side_[static_cast<size_t>(g)] = s;
+          break;
+        }
+      }
+    }
+  }
+
+  // The torso: the child of the deepest waist hinge.
+  int deepest = -1;
+  for (int k = 0; k < n; ++k) {
+    const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
+    if (body.groups[static_cast<size_t>(j.group)].role != JointRole::kWaist) continue;
+    if (deepest < 0 || depth(m, j.body) > depth(m, deepest)) deepest = j.body;
+  }
+  torso_body_ = deepest;
+  for (int k = 0; k < n && deepest >= 0; ++k) {
+    const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
+    if (j.body == deepest && body.groups[static_cast<size_t>(j.group)].role == JointRole::kWaist) {
+      waist_.push_back(k);
+    }
+  }
+
+  // The standing pose: feet's up vectors, the torso in the root, the COM height.
+  mjData* d0 = mj_makeData(m);
+  mju_copy(d0->qpos, m->qpos0, m->nq);
+  mj_kinematics(m, d0);
+  mj_comPos(m, d0);
+  for (int s = 0; s < 2; ++s) {
+    const double* R = d0->xmat + 9 * body.feet[static_cast<size_t>(s)];
+    foot_up_[static_cast<size_t>(s)] = {R[6], R[7], R[8]};
+  }
+  for (int i = 0; i < 4; ++i) root_standing_[static_cast<size_t>(i)] = d0->xquat[4 * root + i];
+  if (torso_body_ >= 0) {
+    double inv[4];
+    mju_negQuat(inv, d0->xquat + 4 * root);
+    mju_mulQuat(torso_in_root_.data(), inv, d0->xquat + 4 * torso_body_);
+  }
+  mass_ = m->body_subtreemass[root];
+  gravity_ = -m->opt.gravity[2];
+  const double standing_height = d0->subtree_com[3 * root + 2];
+  mj_deleteData(d0);
+  root_kp_ = gains_.root_kp > 0 ? gains_.root_kp : 2 * mass_ * gravity_ * standing_height;
+  root_kd_ = gains_.root_kd > 0 ? gains_.root_kd : root_kp_ / 10;
+  height_target_ = standing_height;
+}
+
+void StanceController::set_targets(std::vector<double> targets) {
+  if (targets.size() != targets_.size()) {
+    throw std::invalid_argument("StanceController::set_targets: expected one target per joint");
+  }
+  targets_ = std::move(targets);
+}
+
+void StanceController::measure(const mjModel* m, const mjData* d) {
+  const int root = body_.root_body;
+  const double* c = d->subtree_com + 3 * root;
+  com_ = {c[0], c[1], c[2]};
+  // COM velocity from the bodies' com-based velocities (d->cvel: angular, then linear at
+  // the subtree COM of the tree's root, world orientation).
+  double p[3] = {0, 0, 0};
+  for (int b : body_.links) {
+    const double* v = d->cvel + 6 * b;
+    const double* o = d->subtree_com + 3 * m->body_rootid[b];
+    double r[3] = {d->xipos[3 * b] - o[0], d->xipos[3 * b + 1] - o[1], d->xipos[3 * b + 2] - o[2]};
+    double w_r[3];
+    mju_cross(w_r, v, r);
+    for (int i = 0; i < 3; ++i) p[i] += m->body_mass[b] * (v[3 + i] + w_r[i]);
+  }
+  for (int i = 0; i < 3; ++i) com_vel_[static_cast<size_t>(i)] = p[i] / mass_;
+}
+
+bool StanceController::foot_contact(const mjModel* m, const mjData* d, int side) const {
+  (void)m;
+  for (int c = 0; c < d->ncon; ++c) {
+    const mjContact& con = d->contact[c];
+    if (geom_side_[static_cast<size_t>(con.geom1)] == side || geom_side_[static_cast<size_t>(con.geom2)] == side) {
+      return true;
+    }
+  }
+  return false;
+}
+
+void StanceController::reset(const mjModel* m, const mjData* d) {
+  measure(m, d);
+  height_target_ = com_[2];
+  const int root = body_.root_body;
+  const double turn = heading(d->xquat + 4 * root) - heading(root_standing_.data());
+  const double yaw[4] = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
+  mju_mulQuat(root_target_.data(), yaw, root_standing_.data());
+}
+
+void StanceController::control(const mjModel* m, const mjData* d, JointDrive& drive) {
+  const int n = body_.dof();
+  const int root = body_.root_body;
+  measure(m, d);
+  for (int s = 0; s < 2; ++s) stance_[static_cast<size_t>(s)] = foot_contact(m, d, s);
+  const int legs = (stance_[0] ? 1 : 0) + (stance_[1] ? 1 : 0);
+
+  // Support polygon, its centre, the soles' height.
+  force_ = {0, 0, 0};
+  if (legs > 0) {
+    std::vector<Vec2> corners;
+    Vec2 centre{0, 0};
+    double centres = 0, sole = INFINITY;
+    for (int g = 0; g < m->ngeom; ++g) {
+      const int s = geom_side_[static_cast<size_t>(g)];
+      if (s < 0 || !stance_[static_cast<size_t>(s)]) continue;
+      const double* x = d->geom_xpos + 3 * g;
+      const double* R = d->geom_xmat + 9 * g;
+      const double* size = m->geom_size + 3 * g;
+      if (m->geom_type[g] == mjGEOM_BOX) {
+        for (int corner = 0; corner < 8; ++corner) {
+          const double l[3] = {(corner & 1 ? 1 : -1) * size[0], (corner & 2 ? 1 : -1) * size[1],
+                               (corner & 4 ? 1 : -1) * size[2]};
+          double w[3];
+          mju_mulMatVec(w, R, l, 3, 3);
+          corners.push_back({x[0] + w[0], x[1] + w[1]});
+          sole = std::min(sole, x[2] + w[2]);
+        }
+      } else {
+        const double r = m->geom_rbound[g];
+        for (int corner = 0; corner < 4; ++corner) {
+          corners.push_back({x[0] + (corner & 1 ? r : -r), x[1] + (corner & 2 ? r : -r)});
+        }
+        sole = std::min(sole, x[2] - r);
+      }
+      centre[0] += x[0];
+      centre[1] += x[1];
+      centres += 1;
+    }
+    support_ = {centre[0] / centres, centre[1] / centres};
+
+    const double M = mass_;
+    double fx = M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * com_vel_[0]);
+    double fy = M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * com_vel_[1]);
+    double fz = M * (gravity_ + gains_.height_kp * (height_target_ - com_[2]) - gains_.height_kd * com_vel_[2]);
+    fz = std::max(fz, 0.1 * M * gravity_);
+    // Keep the centre of pressure inside the support polygon.
+    const double h = std::max(com_[2] - sole, 0.05);
+    const std::vector<Vec2> polygon = shrink(convex_hull(corners), gains_.cop_margin);
+    const Vec2 cop{com_[0] - h * fx / fz, com_[1] - h * fy / fz};
+    const Vec2 held = project(polygon, cop);
+    if (held != cop) {
+      fx = (com_[0] - held[0]) * fz / h;
+      fy = (com_[1] - held[1]) * fz / h;
+    }
+    force_ = {fx, fy, fz};
+  }
+
+  // Default: PD toward the targets, gravity compensation off the stance legs.
+  for (int k = 0; k < n; ++k) {
+    const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+    const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
+    double u = g.kp * (targets_[static_cast<size_t>(k)] - d->qpos[j.qpos]);
+    const int leg = leg_of_[static_cast<size_t>(k)];
+    const bool in_stance = leg >= 0 && stance_[static_cast<size_t>(leg)];
+    if (gains_.gravity_compensation && !in_stance) {
+      const double* a = d->xaxis + 3 * j.joint;
+      const double* p = d->xanchor + 3 * j.joint;
+      const double* c = d->subtree_com + 3 * j.body;
+      const double r[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
+      const double f[3] = {0, 0, m->body_subtreemass[j.body] * gravity_};
+      u += axis_moment(a, r, f);
+    }
+    u_[static_cast<size_t>(k)] = u;
+    kd_[static_cast<size_t>(k)] = g.kd;
+  }
+
+  // Feet flat: the rotation that takes the foot's standing up vector to world up.
+  for (int s = 0; s < 2; ++s) {
+    const int foot = body_.feet[static_cast<size_t>(s)];
+    const double* R = d->xmat + 9 * foot;
+    const double* up0 = foot_up_[static_cast<size_t>(s)].data();
+    double up[3];
+    mju_mulMatVec(up, R, up0, 3, 3);
+    const double z[3] = {0, 0, 1};
+    double e[3];
+    mju_cross(e, up, z);
+    const double sin_angle = mju_norm3(e);
+    const double angle = std::atan2(sin_angle, dot3(up, z));
+    if (sin_angle > 1e-12) mju_scl3(e, e, angle / sin_angle);
+    const double* w_parent = d->cvel + 6 * m->body_parentid[foot];
+    for (int k : legs_[static_cast<size_t>(s)].foot) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
+      const double* a = d->xaxis + 3 * j.joint;
+      u_[static_cast<size_t>(k)] = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
+      kd_[static_cast<size_t>(k)] = g.kd;
+    }
+  }
+
+  // Torso: its standing orientation relative to the root's target, in world.
+  if (torso_body_ >= 0) {
+    double target[4], e[3];
+    mju_mulQuat(target, root_target_.data(), torso_in_root_.data());
+    rotation_error(target, d->xquat + 4 * torso_body_, e);
+    const double* w_parent = d->cvel + 6 * m->body_parentid[torso_body_];
+    for (int k : waist_) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
+      const double* a = d->xaxis + 3 * j.joint;
+      double u = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
+      if (gains_.gravity_compensation) {
+        const double* p = d->xanchor + 3 * j.joint;
+        const double* c = d->subtree_com + 3 * j.body;
+        const double r[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
+        const double f[3] = {0, 0, m->body_subtreemass[j.body] * gravity_};
+        u += axis_moment(a, r, f);
+      }
+      u_[static_cast<size_t>(k)] = u;
+      kd_[static_cast<size_t>(k)] = g.kd;
+    }
+  }
+
+  // Virtual force: tau = J^T F on every hinge of the stance legs below the hips (the
+  // hips' share goes into the root's torque budget below).
+  if (legs > 0) {
+    const double f[3] = {force_[0] / legs, force_[1] / legs, force_[2] / legs};
+    for (int s = 0; s < 2; ++s) {
+      if (!stance_[static_cast<size_t>(s)]) continue;
+      for (int k : legs_[static_cast<size_t>(s)].joints) {
+        if (is_hip_[static_cast<size_t>(k)]) continue;
+        const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+        const double* p = d->xanchor + 3 * j.joint;
+        const double r[3] = {com_[0] - p[0], com_[1] - p[1], com_[2] - p[2]};
+        u_[static_cast<size_t>(k)] -= axis_moment(d->xaxis + 3 * j.joint, r, f);
+      }
+    }
+
+    // Root orientation through the stance hips: the torque the other root hinges put on
+    // the root, made up to the root's PD torque.
+    double e[3];
+    rotation_error(root_target_.data(), d->xquat + 4 * root, e);
+    double budget[3];  // sum over stance hips of tau_h a_h, without the root damping
+    for (int i = 0; i < 3; ++i) budget[i] = -root_kp_ * e[i];
+    for (int k : root_children_) {
+      const int leg = leg_of_[static_cast<size_t>(k)];
+      if (leg >= 0 && stance_[static_cast<size_t>(leg)]) continue;
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      const double tau = std::clamp(u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * d->qvel[j.dof],
+                                    -j.torque_limit, j.torque_limit);
+      const double* a = d->xaxis + 3 * j.joint;
+      for (int i = 0; i < 3; ++i) budget[i] -= tau * a[i];
+    }
+    // Root damping -root_kd w_root, by the identity a_h . w_root = a_h . w_thigh - qdot_h
+    // (the hinges of a universal joint are orthogonal): its -qdot_h part is the hip's own
+    // damping, integrated implicitly by the drive.
+    const double share = 1.0 / legs;
+    for (int s = 0; s < 2; ++s) {
+      if (!stance_[static_cast<size_t>(s)]) continue;
+      for (int k : legs_[static_cast<size_t>(s)].hips) {
+        const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+        const double* a = d->xaxis + 3 * j.joint;
+        const double* w_child = d->cvel + 6 * j.body;
+        u_[static_cast<size_t>(k)] = share * (dot3(a, budget) + root_kd_ * dot3(a, w_child));
+        kd_[static_cast<size_t>(k)] = share * root_kd_;
+      }
+    }
+  }
+
+  for (int k = 0; k < n; ++k) drive.set(k, u_[static_cast<size_t>(k)], kd_[static_cast<size_t>(k)]);
+}
+
+}  // namespace diverse
