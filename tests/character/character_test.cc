@@ -189,8 +189,8 @@ TEST(CharacterErrors, LeftRightPairWithDifferentRanges) {
 
 TEST(CharacterErrors, LeftRightPairOfDifferentJointTypes) {
   Edited c("pair_type");
-  c.xml("<joint name=\"ankle_r\" range=\"-0.9 0.7\" user=\"200\"/>",
-        "<joint name=\"ankle_r\" type=\"slide\" axis=\"0 0 1\" range=\"-0.9 0.7\" user=\"200\"/>");
+  c.xml("<joint name=\"ankle_r\" range=\"-0.9 0.7\"/>",
+        "<joint name=\"ankle_r\" type=\"slide\" axis=\"0 0 1\" range=\"-0.9 0.7\"/>");
   EXPECT_EQ(c.error(), c.file() + ": groups[2].joints: expected 'ankle_r' to be a hinge joint");
 }
 
