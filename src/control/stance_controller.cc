@@ -38,9 +38,9 @@ std::vector<Vec2> convex_hull(std::vector<Vec2> p) {
   return h;
 }
 
-// The convex polygon `h` (counter-clockwise) moved `margin` inward: each edge's line
-// shifted along its inward normal, consecutive lines intersected. If the polygon is too
-// small for the margin, its centroid alone.
+// The convex polygon `h` (counter-clockwise) eroded by `margin`: clipped by each edge's
+// half-plane shifted `margin` inward (Sutherland-Hodgman), which stays right however short
+// the edges are. If nothing is left, the centroid of `h` alone.
 std::vector<Vec2> shrink(const std::vector<Vec2>& h, double margin) {
   const size_t n = h.size();
   Vec2 centroid{0, 0};
@@ -49,32 +49,30 @@ std::vector<Vec2> shrink(const std::vector<Vec2>& h, double margin) {
     centroid[1] += v[1] / static_cast<double>(n);
   }
   if (n < 3) return {centroid};
-  // Line i: points x with n_i . x = c_i, n_i the inward unit normal.
-  std::vector<Vec2> normal(n);
-  std::vector<double> offset(n);
-  for (size_t i = 0; i < n; ++i) {
+  std::vector<Vec2> poly = h, next;
+  for (size_t i = 0; i < n && !poly.empty(); ++i) {
     const Vec2& a = h[i];
     const Vec2& b = h[(i + 1) % n];
-    const double dx = b[0] - a[0], dy = b[1] - a[1];
-    const double len = std::hypot(dx, dy);
-    normal[i] = {-dy / len, dx / len};  // left of a->b: inward for counter-clockwise
-    offset[i] = normal[i][0] * a[0] + normal[i][1] * a[1] + margin;
-  }
-  std::vector<Vec2> out;
-  for (size_t i = 0; i < n; ++i) {
-    const size_t j = (i + n - 1) % n;  // the previous edge meets edge i at vertex i
-    const double det = normal[j][0] * normal[i][1] - normal[j][1] * normal[i][0];
-    if (std::fabs(det) < 1e-12) continue;
-    out.push_back({(offset[j] * normal[i][1] - normal[j][1] * offset[i]) / det,
-                   (normal[j][0] * offset[i] - offset[j] * normal[i][0]) / det});
-  }
-  // Too small: an inverted polygon (some shifted vertex outside another shifted edge).
-  for (const Vec2& v : out) {
-    for (size_t i = 0; i < n; ++i) {
-      if (normal[i][0] * v[0] + normal[i][1] * v[1] < offset[i] - 1e-9) return {centroid};
+    const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
+    if (len < 1e-9) continue;
+    const Vec2 normal{-(b[1] - a[1]) / len, (b[0] - a[0]) / len};  // inward: left of a->b
+    const double c = normal[0] * a[0] + normal[1] * a[1] + margin;
+    next.clear();
+    for (size_t k = 0; k < poly.size(); ++k) {
+      const Vec2& p = poly[k];
+      const Vec2& q = poly[(k + 1) % poly.size()];
+      const double dp = normal[0] * p[0] + normal[1] * p[1] - c;
+      const double dq = normal[0] * q[0] + normal[1] * q[1] - c;
+      if (dp >= 0) next.push_back(p);
+      if ((dp >= 0) != (dq >= 0)) {
+        const double t = dp / (dp - dq);
+        next.push_back({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])});
+      }
     }
+    poly.swap(next);
   }
-  return out.size() >= 3 ? out : std::vector<Vec2>{centroid};
+  if (poly.size() < 3) return {centroid};
+  return poly;
 }
 
 // The point of the convex polygon `h` (counter-clockwise) nearest to p.
@@ -151,7 +149,6 @@ StanceController::StanceController(const Character& body, const mjModel* m, Stan
   kd_.assign(static_cast<size_t>(n), 0.0);
   leg_of_.assign(static_cast<size_t>(n), -1);
   is_hip_.assign(static_cast<size_t>(n), 0);
-  is_foot_.assign(static_cast<size_t>(n), 0);
   std::vector<int> index_of(static_cast<size_t>(m->njnt), -1);
   for (int k = 0; k < n; ++k) {
     const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
@@ -166,14 +163,14 @@ StanceController::StanceController(const Character& body, const mjModel* m, Stan
     const int foot = body.feet[static_cast<size_t>(s)];
     Leg& leg = legs_[static_cast<size_t>(s)];
     for (int b = foot; b != root && b > 0; b = m->body_parentid[b]) {
-      for (int jj = m->body_jntadr[b]; jj >= 0 && jj < m->body_jntadr[b] + m->body_jntnum[b]; ++jj) {
+      for (int jj = m->body_jntadr[b]; jj >= 0 && jj < m->body_jntadr[b] + m->body_jntnum[b];
+           ++jj) {
         const int k = index_of[static_cast<size_t>(jj)];
         if (k < 0) continue;
         leg.joints.push_back(k);
         leg_of_[static_cast<size_t>(k)] = s;
         if (b == foot) {
           leg.foot.push_back(k);
-          is_foot_[static_cast<size_t>(k)] = 1;
         }
         if (m->body_parentid[b] == root) {
           leg.hips.push_back(k);
@@ -237,6 +234,67 @@ void StanceController::set_targets(std::vector<double> targets) {
   targets_ = std::move(targets);
 }
 
+std::vector<double> StanceController::standing_pose(const mjModel* m) const {
+  const int root = body_.root_body;
+  std::vector<int> hips, feet;  // sagittal hinges of the hips and of the feet
+  for (int s = 0; s < 2; ++s) {
+    for (int k : legs_[static_cast<size_t>(s)].hips) {
+      if (body_.groups[static_cast<size_t>(body_.joints[static_cast<size_t>(k)].group)].plane ==
+          JointPlane::kSagittal)
+        hips.push_back(k);
+    }
+    for (int k : legs_[static_cast<size_t>(s)].foot) {
+      if (body_.groups[static_cast<size_t>(body_.joints[static_cast<size_t>(k)].group)].plane ==
+          JointPlane::kSagittal)
+        feet.push_back(k);
+    }
+  }
+  mjData* d = mj_makeData(m);
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  mj_kinematics(m, d);
+  std::array<std::array<double, 3>, 2> foot0{};
+  double centre_x = 0, geoms = 0;
+  for (int s = 0; s < 2; ++s) {
+    const double* x = d->xpos + 3 * body_.feet[static_cast<size_t>(s)];
+    foot0[static_cast<size_t>(s)] = {x[0], x[1], x[2]};
+  }
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (geom_side_[static_cast<size_t>(g)] < 0) continue;
+    centre_x += d->geom_xpos[3 * g];
+    geoms += 1;
+  }
+  const double goal = centre_x / std::max(geoms, 1.0) + offset_[0];
+  // COM x minus the goal with the legs leaned by theta and the soles where they were.
+  auto lean = [&](double theta) {
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    for (int k : hips) d->qpos[body_.joints[static_cast<size_t>(k)].qpos] -= theta;
+    for (int k : feet) d->qpos[body_.joints[static_cast<size_t>(k)].qpos] += theta;
+    mj_kinematics(m, d);
+    for (int i = 0; i < 3; i += 2) {
+      double shift = 0;
+      for (int s = 0; s < 2; ++s)
+        shift += d->xpos[3 * body_.feet[static_cast<size_t>(s)] + i] -
+                 foot0[static_cast<size_t>(s)][static_cast<size_t>(i)];
+      d->qpos[body_.root_qpos + i] -= shift / 2;
+    }
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    return d->subtree_com[3 * root] - goal;
+  };
+  // Secant iterations; the COM moves about its height times theta.
+  double t0 = 0, e0 = lean(t0), t1 = 0.05, e1 = lean(t1);
+  for (int it = 0; it < 20 && std::fabs(e1) > 1e-6 && std::fabs(e1 - e0) > 1e-12; ++it) {
+    const double t2 = t1 - e1 * (t1 - t0) / (e1 - e0);
+    t0 = t1;
+    e0 = e1;
+    t1 = std::clamp(t2, -0.5, 0.5);
+    e1 = lean(t1);
+  }
+  std::vector<double> qpos(d->qpos, d->qpos + m->nq);
+  mj_deleteData(d);
+  return qpos;
+}
+
 void StanceController::measure(const mjModel* m, const mjData* d) {
   const int root = body_.root_body;
   const double* c = d->subtree_com + 3 * root;
@@ -255,11 +313,11 @@ void StanceController::measure(const mjModel* m, const mjData* d) {
   for (int i = 0; i < 3; ++i) com_vel_[static_cast<size_t>(i)] = p[i] / mass_;
 }
 
-bool StanceController::foot_contact(const mjModel* m, const mjData* d, int side) const {
-  (void)m;
+bool StanceController::foot_contact(const mjData* d, int side) const {
   for (int c = 0; c < d->ncon; ++c) {
     const mjContact& con = d->contact[c];
-    if (geom_side_[static_cast<size_t>(con.geom1)] == side || geom_side_[static_cast<size_t>(con.geom2)] == side) {
+    if (geom_side_[static_cast<size_t>(con.geom1)] == side ||
+        geom_side_[static_cast<size_t>(con.geom2)] == side) {
       return true;
     }
   }
@@ -279,14 +337,18 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
   const int n = body_.dof();
   const int root = body_.root_body;
   measure(m, d);
-  for (int s = 0; s < 2; ++s) stance_[static_cast<size_t>(s)] = foot_contact(m, d, s);
+  for (int s = 0; s < 2; ++s) stance_[static_cast<size_t>(s)] = foot_contact(d, s);
   const int legs = (stance_[0] ? 1 : 0) + (stance_[1] ? 1 : 0);
 
   // Support polygon, its centre, the soles' height.
   force_ = {0, 0, 0};
+  load_ = {0, 0};
+  leg_force_ = {};
+  std::array<Vec2, 2> foot_centre{};  // centre of each stance sole (m, world x y)
   if (legs > 0) {
     std::vector<Vec2> corners;
     Vec2 centre{0, 0};
+    std::array<double, 2> geoms{0, 0};
     double centres = 0, sole = INFINITY;
     for (int g = 0; g < m->ngeom; ++g) {
       const int s = geom_side_[static_cast<size_t>(g)];
@@ -313,13 +375,23 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       centre[0] += x[0];
       centre[1] += x[1];
       centres += 1;
+      foot_centre[static_cast<size_t>(s)][0] += x[0];
+      foot_centre[static_cast<size_t>(s)][1] += x[1];
+      geoms[static_cast<size_t>(s)] += 1;
     }
     support_ = {centre[0] / centres, centre[1] / centres};
+    for (int s = 0; s < 2; ++s) {
+      for (double& v : foot_centre[static_cast<size_t>(s)])
+        v /= std::max(geoms[static_cast<size_t>(s)], 1.0);
+    }
 
     const double M = mass_;
-    double fx = M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * com_vel_[0]);
-    double fy = M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * com_vel_[1]);
-    double fz = M * (gravity_ + gains_.height_kp * (height_target_ - com_[2]) - gains_.height_kd * com_vel_[2]);
+    double fx =
+        M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * com_vel_[0]);
+    double fy =
+        M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * com_vel_[1]);
+    double fz = M * (gravity_ + gains_.height_kp * (height_target_ - com_[2]) -
+                     gains_.height_kd * com_vel_[2]);
     fz = std::max(fz, 0.1 * M * gravity_);
     // Keep the centre of pressure inside the support polygon.
     const double h = std::max(com_[2] - sole, 0.05);
@@ -331,6 +403,35 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       fy = (com_[1] - held[1]) * fz / h;
     }
     force_ = {fx, fy, fz};
+
+    // Share the load: the centre of pressure `held` between the soles' centres gives each
+    // stance foot its part alpha_s (by where `held` lies on the line between them); each
+    // foot's own centre of pressure is its sole's centre moved by what lies off that line,
+    // so that sum alpha_s cop_s = held; and each leg pushes alpha_s F from there. The legs'
+    // forces add up to F, their moment about the COM is (held - c) x F = 0, and they do not
+    // squeeze the feet apart.
+    std::array<double, 2> load{stance_[0] ? 1.0 : 0.0, stance_[1] ? 1.0 : 0.0};
+    const int first = stance_[0] ? 0 : 1;
+    Vec2 residual{held[0] - foot_centre[static_cast<size_t>(first)][0],
+                  held[1] - foot_centre[static_cast<size_t>(first)][1]};
+    if (legs == 2) {
+      const Vec2& l = foot_centre[0];
+      const Vec2& r = foot_centre[1];
+      const double dx = l[0] - r[0], dy = l[1] - r[1];
+      const double len2 = dx * dx + dy * dy;
+      double alpha = len2 > 1e-8 ? ((held[0] - r[0]) * dx + (held[1] - r[1]) * dy) / len2 : 0.5;
+      alpha = std::clamp(alpha, 0.0, 1.0);
+      load = {alpha, 1 - alpha};
+      residual = {held[0] - (alpha * l[0] + (1 - alpha) * r[0]),
+                  held[1] - (alpha * l[1] + (1 - alpha) * r[1])};
+    }
+    for (int s = 0; s < 2; ++s) {
+      const Vec2& f = foot_centre[static_cast<size_t>(s)];
+      const double a = load[static_cast<size_t>(s)];
+      leg_force_[static_cast<size_t>(s)] = {a * fx, a * fy, a * fz};
+      leg_cop_[static_cast<size_t>(s)] = {f[0] + residual[0], f[1] + residual[1], sole};
+    }
+    load_ = load;
   }
 
   // Default: PD toward the targets, gravity compensation off the stance legs.
@@ -398,48 +499,57 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     }
   }
 
-  // Virtual force: tau = J^T F on every hinge of the stance legs below the hips (the
-  // hips' share goes into the root's torque budget below).
+  // Stance legs: each realizes its share of the virtual force and of the torque the root
+  // needs, tau = J^T (F_leg, T_leg), J the Jacobian of the point where the leg's force acts
+  // and of the root's orientation with the foot as the base: for every hinge j of the leg,
+  // tau_j = -a_j . ((cop_leg - p_j) x F_leg) - a_j . T_leg. The root needs its PD
+  // torque, T = root_kp e - root_kd w_root, plus what the other hinges on it (waist, swing
+  // hips) take away, sum of tau_o a_o. Driving the whole leg this way (not just the hip, as
+  // SIMBICON's tau_stance = -tau_torso - tau_swing does) leaves the legs' sideways sway,
+  // which does not turn the root, to the COM force alone.
   if (legs > 0) {
-    const double f[3] = {force_[0] / legs, force_[1] / legs, force_[2] / legs};
-    for (int s = 0; s < 2; ++s) {
-      if (!stance_[static_cast<size_t>(s)]) continue;
-      for (int k : legs_[static_cast<size_t>(s)].joints) {
-        if (is_hip_[static_cast<size_t>(k)]) continue;
-        const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-        const double* p = d->xanchor + 3 * j.joint;
-        const double r[3] = {com_[0] - p[0], com_[1] - p[1], com_[2] - p[2]};
-        u_[static_cast<size_t>(k)] -= axis_moment(d->xaxis + 3 * j.joint, r, f);
-      }
-    }
-
-    // Root orientation through the stance hips: the torque the other root hinges put on
-    // the root, made up to the root's PD torque.
     double e[3];
     rotation_error(root_target_.data(), d->xquat + 4 * root, e);
-    double budget[3];  // sum over stance hips of tau_h a_h, without the root damping
-    for (int i = 0; i < 3; ++i) budget[i] = -root_kp_ * e[i];
+    double torque[3];  // T without its damping part
+    for (int i = 0; i < 3; ++i) torque[i] = root_kp_ * e[i];
     for (int k : root_children_) {
       const int leg = leg_of_[static_cast<size_t>(k)];
       if (leg >= 0 && stance_[static_cast<size_t>(leg)]) continue;
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-      const double tau = std::clamp(u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * d->qvel[j.dof],
-                                    -j.torque_limit, j.torque_limit);
+      const double tau =
+          std::clamp(u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * d->qvel[j.dof],
+                     -j.torque_limit, j.torque_limit);
       const double* a = d->xaxis + 3 * j.joint;
-      for (int i = 0; i < 3; ++i) budget[i] -= tau * a[i];
+      for (int i = 0; i < 3; ++i) torque[i] += tau * a[i];
     }
-    // Root damping -root_kd w_root, by the identity a_h . w_root = a_h . w_thigh - qdot_h
-    // (the hinges of a universal joint are orthogonal): its -qdot_h part is the hip's own
-    // damping, integrated implicitly by the drive.
-    const double share = 1.0 / legs;
+    const double* w_root = d->cvel + 6 * root;
+    // The legs share T by load, each stance leg at least a tenth.
+    std::array<double, 2> share{};
+    for (int s = 0; s < 2; ++s)
+      share[static_cast<size_t>(s)] =
+          stance_[static_cast<size_t>(s)] ? std::max(load_[static_cast<size_t>(s)], 0.1) : 0.0;
+    const double total = share[0] + share[1];
     for (int s = 0; s < 2; ++s) {
       if (!stance_[static_cast<size_t>(s)]) continue;
-      for (int k : legs_[static_cast<size_t>(s)].hips) {
+      const double w = share[static_cast<size_t>(s)] / total;
+      const double* f = leg_force_[static_cast<size_t>(s)].data();
+      for (int k : legs_[static_cast<size_t>(s)].joints) {
         const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
         const double* a = d->xaxis + 3 * j.joint;
-        const double* w_child = d->cvel + 6 * j.body;
-        u_[static_cast<size_t>(k)] = share * (dot3(a, budget) + root_kd_ * dot3(a, w_child));
-        kd_[static_cast<size_t>(k)] = share * root_kd_;
+        const double* p = d->xanchor + 3 * j.joint;
+        const double* cop = leg_cop_[static_cast<size_t>(s)].data();
+        const double r[3] = {cop[0] - p[0], cop[1] - p[1], cop[2] - p[2]};
+        const double jt = -axis_moment(a, r, f) - w * dot3(a, torque);
+        if (is_hip_[static_cast<size_t>(k)]) {
+          // The hip replaces its joint PD. Root damping +w root_kd (a . w_root), by the
+          // identity a . w_root = a . w_thigh - qdot (the hinges of a universal joint are
+          // orthogonal): its -qdot part is the hip's own damping, implicit in the drive.
+          const double* w_child = d->cvel + 6 * j.body;
+          u_[static_cast<size_t>(k)] = jt + w * root_kd_ * dot3(a, w_child);
+          kd_[static_cast<size_t>(k)] = w * root_kd_;
+        } else {
+          u_[static_cast<size_t>(k)] += jt + w * root_kd_ * dot3(a, w_root);
+        }
       }
     }
   }

@@ -14,41 +14,53 @@
 // Per step, with the stance legs those whose foot (or a body below it) touches something:
 //
 // - Centre of mass. A virtual force on the COM (Pratt et al. 2001),
-//       F_xy = M (com_kp (s + offset - c) - com_kd v),  F_z = M (g + height_kp (h0 - c_z)
-//              - height_kd v_z),
-//   with s the centre of the stance feet's soles, c and v the COM and its velocity, h0 the
-//   COM height at reset(). F_xy is limited so that the centre of pressure it implies,
-//   c_xy - h F_xy / F_z (h the COM height above the soles), stays cop_margin inside the
-//   support polygon (the convex hull of the stance soles): a larger ankle torque would only
-//   tip the feet. F is split equally over the stance legs and realized as joint torques
-//   tau = J^T F: for every hinge j between a stance foot and the root,
-//       tau_j = -a_j . ((c - p_j) x F_leg)
-//   (a_j its world axis d->xaxis, p_j its anchor; the minus because MuJoCo's tree runs from
-//   the root down and the hinge turns the foot side, while J is the COM's Jacobian with the
-//   foot as the base).
-// - Root and torso. The root (pelvis) tracks an upright orientation with the heading it had
+//       F_xy = M (com_kp (s + offset - c) - com_kd v),
+//       F_z  = M (g + height_kp (h0 - c_z) - height_kd v_z),
+//   with s the centre of the stance soles, c and v the COM and its velocity, h0 the COM
+//   height at reset(). F_xy is limited so that the centre of pressure it implies,
+//   p = c_xy - h F_xy / F_z (h the COM height above the soles), stays cop_margin inside
+//   the support polygon (the convex hull of the stance soles): a larger ankle torque would
+//   only tip the feet.
+// - Sharing F between the legs. Where p lies on the line between the two soles' centres
+//   gives each foot its share alpha_s of the load; each foot's own centre of pressure cop_s
+//   is its sole's centre moved by what lies off that line (so sum alpha_s cop_s = p), and
+//   each leg pushes alpha_s F from cop_s. The legs' forces add up to F, their moment about
+//   the COM is (p - c) x F = 0, and they do not squeeze the feet apart (the feet would
+//   creep on MuJoCo's soft friction).
+// - Root (pelvis) and torso. The root tracks an upright orientation with the heading it had
 //   at reset(): a world torque T = root_kp e_root - root_kd w_root (e the rotation vector to
-//   the target, w the angular velocity). The root is unactuated, so the torque comes from
-//   the stance hips: the hinges under the root body that are not in a stance leg (waist,
-//   swing hips) act on it too, and the stance hips make up the rest (SIMBICON's
-//   tau_stance = -tau_torso - tau_swing; Coros et al. 2010):
-//       sum over stance hips of tau_h a_h = -T - sum over other root hinges of tau_o a_o,
-//   shared equally by the stance legs and projected on each hip hinge's axis
-//   (tau_h = a_h . H_leg; a universal hip loses the yaw part). The J^T F part of the hips
-//   is added to it. The torso (the child of the deepest waist hinge, if any) tracks its
-//   standing orientation relative to the root's target with the waist hinges:
-//   tau_w = a_w . (kp e_torso) - kd (a_w . w_torso), gains of the waist group.
+//   the target, w the angular velocity). The root is unactuated, so the stance legs supply
+//   T plus what the other hinges on the root (waist, swing hips) take away, sum tau_o a_o
+//   (SIMBICON's tau_stance = -tau_torso - tau_swing, Coros et al. 2010), shared by load
+//   (each stance leg at least a tenth); a universal hip cannot turn the root about its
+//   missing axis, so the yaw part is lost. The torso (the child of the deepest waist hinge,
+//   if any) tracks its standing orientation relative to the root's target with the waist
+//   hinges: tau_w = a_w . (kp e_torso) - kd (a_w . w_torso), the waist group's gains.
+// - Stance legs: J^T. Each stance leg realizes its force and its share of the root torque,
+//   tau = J^T (F_leg, T_leg), J the Jacobian of the point cop_s and of the root's
+//   orientation with the foot as the base; for every hinge j between the foot and the root
+//       tau_j = -a_j . ((cop_s - p_j) x F_leg) - a_j . T_leg
+//   (a_j its world axis d->xaxis, p_j its anchor; the minus because MuJoCo's tree runs from
+//   the root down, the hinge turning the foot side). Driving the whole leg this way (not
+//   just the hip) leaves the legs' sideways sway, which does not turn the root, to the COM
+//   force alone. The hips get only these torques; the knees (and the bird's ankles) add
+//   them to their PD toward the targets.
 // - Feet. The hinges of each foot body keep the sole flat: they track the rotation that
 //   turns the foot's standing "up" to world up, tau = a . (kp e_foot) - kd (a . w_foot),
-//   with the foot group's gains, plus their J^T F share in stance.
-// - Everything else (knees, the bird's ankles, arms, neck, swing legs) is PD toward the
-//   targets, kp (target - q) - kd qdot with the character file's group gains, plus, off the
-//   stance legs, gravity compensation tau_j = a_j . ((c_sub - p_j) x m_sub g z) for the
-//   links the hinge carries (c_sub, m_sub the subtree's COM and mass).
+//   with the foot group's gains, plus the J^T terms in stance.
+// - Everything else (arms, neck, swing legs) is PD toward the targets,
+//   kp (target - q) - kd qdot with the character file's group gains, plus gravity
+//   compensation tau_j = a_j . ((c_sub - p_j) x m_sub g z) for the links the hinge carries
+//   (c_sub, m_sub the subtree's COM and mass).
 //
-// Damping. Every term's derivative part -kd (a . w_child) is split into the joint's own rate,
-// -kd qdot (which the drive integrates implicitly), and -kd (a . w_parent) in u, so large
-// gains stay stable at a 2 ms step.
+// Damping. A term's derivative part on a link's world rate, -kd (a . w_child), is split into
+// the joint's own rate, -kd qdot (which the drive integrates implicitly), and
+// -kd (a . w_parent) in u (a . w_child = a . w_parent + qdot for the orthogonal hinges of a
+// universal joint), so large gains stay stable at a 2 ms step.
+//
+// The start pose: standing_pose() leans the legs of qpos0 about the feet until the COM is
+// over the middle of the soles (a human's COM at qpos0 is over its ankles, 7 cm from the
+// heels, too close to the edge to catch a 0.3 m/s push backward).
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -62,20 +74,20 @@
 namespace diverse {
 
 struct StanceGains {
-  double com_kp = 40;        // 1/s^2: F_xy = M (com_kp e - com_kd v)
-  double com_kd = 12;        // 1/s
-  double height_kp = 100;    // 1/s^2, vertical COM servo around the reset height
-  double height_kd = 20;     // 1/s
-  double root_kp = 0;        // Nm/rad; 0: 2 M g h0 (M the mass, h0 the standing COM height)
-  double root_kd = 0;        // Nm s/rad; 0: root_kp / 10 s
-  double cop_margin = 0.02;  // m, the centre of pressure stays this far inside the support
+  double com_kp = 40;                // 1/s^2: F_xy = M (com_kp e - com_kd v)
+  double com_kd = 12;                // 1/s
+  double height_kp = 100;            // 1/s^2, vertical COM servo around the reset height
+  double height_kd = 20;             // 1/s
+  double root_kp = 0;                // Nm/rad; 0: 2 M g h0 (M the mass, h0 the standing COM height)
+  double root_kd = 0;                // Nm s/rad; 0: root_kp / 10 s
+  double cop_margin = 0.02;          // m, the centre of pressure stays this far inside the support
   bool gravity_compensation = true;  // on the joints off the stance legs
 };
 
 class StanceController {
  public:
-  // `m` is the model `body` was bound to. Targets start at the model's standing pose
-  // (qpos0 of every joint of the character).
+  // `m` is the model `body` was bound to (free root: std::invalid_argument otherwise).
+  // Targets start at the model's standing pose (qpos0 of every joint of the character).
   StanceController(const Character& body, const mjModel* m, StanceGains gains = {});
 
   // The joint targets (rad), one per Character::joints entry. Joints whose body is a foot,
@@ -84,6 +96,12 @@ class StanceController {
   const std::vector<double>& targets() const { return targets_; }
   // Where the COM is held relative to the centre of the stance soles (m, world x, y).
   void set_com_offset(double x, double y) { offset_ = {x, y}; }
+
+  // A start pose for standing: the model's qpos0 with each leg leaned about its foot (the
+  // sagittal hinges of the hips turned by -theta and of the feet by +theta, so the root
+  // stays upright and the soles flat, the root moved so the soles stay where they were)
+  // until the COM is over the centre of the soles plus the COM offset (x only). qpos (nq).
+  std::vector<double> standing_pose(const mjModel* m) const;
 
   // Takes the world targets from the state in d (after mj_step1 or mj_forward): the
   // heading of the root, the COM height.
@@ -98,6 +116,8 @@ class StanceController {
   const std::array<double, 3>& virtual_force() const { return force_; }
   const std::array<double, 2>& support_centre() const { return support_; }
   const std::array<bool, 2>& stance() const { return stance_; }
+  // Each stance foot's share of the vertical force (sums to 1 in stance).
+  const std::array<double, 2>& load() const { return load_; }
   double mass() const { return mass_; }
 
  private:
@@ -107,7 +127,7 @@ class StanceController {
     std::vector<int> foot;    // those on the foot body
   };
   void measure(const mjModel* m, const mjData* d);
-  bool foot_contact(const mjModel* m, const mjData* d, int side) const;
+  bool foot_contact(const mjData* d, int side) const;
 
   const Character& body_;
   StanceGains gains_;
@@ -116,13 +136,13 @@ class StanceController {
 
   // Structure, found once.
   std::array<Leg, 2> legs_;
-  std::vector<int> leg_of_;        // per joint: 0, 1 (in a leg chain) or -1
-  std::vector<char> is_hip_, is_foot_;
-  std::vector<int> waist_;         // joints tracking the torso orientation
-  int torso_body_ = -1;            // MuJoCo body id, or -1 when there is no waist
-  std::vector<int> root_children_; // joints whose body's parent is the root body
-  std::vector<int> geom_side_;     // per geom: 0, 1 (a foot or a body below it) or -1
-  std::array<std::array<double, 3>, 2> foot_up_{};  // standing "up" in each foot's frame
+  std::vector<int> leg_of_;         // per joint: 0, 1 (in a leg chain) or -1
+  std::vector<char> is_hip_;        // per joint: a stance-leg hinge on a child of the root
+  std::vector<int> waist_;          // joints tracking the torso orientation
+  int torso_body_ = -1;             // MuJoCo body id, or -1 when there is no waist
+  std::vector<int> root_children_;  // joints whose body's parent is the root body
+  std::vector<int> geom_side_;      // per geom: 0, 1 (a foot or a body below it) or -1
+  std::array<std::array<double, 3>, 2> foot_up_{};   // standing "up" in each foot's frame
   std::array<double, 4> torso_in_root_{1, 0, 0, 0};  // standing torso orientation in root
   std::array<double, 4> root_standing_{1, 0, 0, 0};  // root orientation at qpos0
   double mass_ = 0, gravity_ = 9.81;
@@ -136,6 +156,9 @@ class StanceController {
   std::array<double, 3> com_{}, com_vel_{}, force_{};
   std::array<double, 2> support_{};
   std::array<bool, 2> stance_{false, false};
+  std::array<double, 2> load_{0, 0};
+  std::array<std::array<double, 3>, 2> leg_force_{};  // N, the virtual force of each leg
+  std::array<std::array<double, 3>, 2> leg_cop_{};    // m, where it acts (on the ground)
   std::vector<double> u_, kd_;
 };
 

@@ -4,13 +4,16 @@
 // mirror images, and a character file that covers every joint once.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
+#include <toml++/toml.h>
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
-#include <toml++/toml.h>
 #include <vector>
+
+#include "character/character.h"
 
 namespace {
 
@@ -58,13 +61,21 @@ void z_extent(const mjModel* m, const mjData* d, int g, double* lo, double* hi) 
   const double* s = m->geom_size + 3 * g;
   double half = m->geom_rbound[g];
   switch (m->geom_type[g]) {
-    case mjGEOM_SPHERE: half = s[0]; break;
-    case mjGEOM_CAPSULE: half = std::fabs(R[8]) * s[1] + s[0]; break;
-    case mjGEOM_BOX: half = std::fabs(R[6]) * s[0] + std::fabs(R[7]) * s[1] + std::fabs(R[8]) * s[2]; break;
-    case mjGEOM_ELLIPSOID:
-      half = std::sqrt(R[6] * R[6] * s[0] * s[0] + R[7] * R[7] * s[1] * s[1] + R[8] * R[8] * s[2] * s[2]);
+    case mjGEOM_SPHERE:
+      half = s[0];
       break;
-    default: break;
+    case mjGEOM_CAPSULE:
+      half = std::fabs(R[8]) * s[1] + s[0];
+      break;
+    case mjGEOM_BOX:
+      half = std::fabs(R[6]) * s[0] + std::fabs(R[7]) * s[1] + std::fabs(R[8]) * s[2];
+      break;
+    case mjGEOM_ELLIPSOID:
+      half = std::sqrt(R[6] * R[6] * s[0] * s[0] + R[7] * R[7] * s[1] * s[1] +
+                       R[8] * R[8] * s[2] * s[2]);
+      break;
+    default:
+      break;
   }
   *lo = p[2] - half;
   *hi = p[2] + half;
@@ -97,7 +108,8 @@ Groups read_groups(const std::string& path) {
   if (const toml::array* a = t["hands"]["bodies"].as_array()) {
     for (const toml::node& j : *a) g.hands.push_back(j.value_or(std::string()));
   }
-  for (const toml::node& j : *t["feet"]["bodies"].as_array()) g.feet.push_back(j.value_or(std::string()));
+  for (const toml::node& j : *t["feet"]["bodies"].as_array())
+    g.feet.push_back(j.value_or(std::string()));
   EXPECT_FALSE(t.contains("shape"));
   return g;
 }
@@ -217,9 +229,9 @@ TEST(Characters3d, HumanTorqueLimitsAreThePapers) {
   Model model(asset("human3d", ".xml"));
   ASSERT_NE(model.m, nullptr);
   const mjModel* m = model.m;
-  const std::map<std::string, double> limit{{"hip", 200},      {"waist", 200}, {"knee", 150},
-                                            {"ankle", 150},    {"neck", 50},   {"shoulder", 100},
-                                            {"elbow", 100},    {"wrist", 100}};
+  const std::map<std::string, double> limit{{"hip", 200},   {"waist", 200}, {"knee", 150},
+                                            {"ankle", 150}, {"neck", 50},   {"shoulder", 100},
+                                            {"elbow", 100}, {"wrist", 100}};
   for (int a = 0; a < m->nu; ++a) {
     const std::string joint = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * a]);
     const std::string kind = joint.substr(0, joint.find('_'));
@@ -383,13 +395,41 @@ TEST_P(Characters3d, StiffPdHoldsTheStandingPoseStably) {
     for (int c = 0; c < d->ncon; ++c) {
       const int b1 = m->geom_bodyid[d->contact[c].geom1], b2 = m->geom_bodyid[d->contact[c].geom2];
       const int b = b1 == 0 ? b2 : b1;
-      ASSERT_TRUE(b == foot_l || b == foot_r) << mj_id2name(m, mjOBJ_BODY, b) << " touches the floor";
+      ASSERT_TRUE(b == foot_l || b == foot_r)
+          << mj_id2name(m, mjOBJ_BODY, b) << " touches the floor";
     }
     for (int i = 0; i < m->nv; ++i) max_speed = std::max(max_speed, std::fabs(d->qvel[i]));
   }
   for (int w = 0; w < mjNWARNING; ++w) EXPECT_EQ(d->warning[w].number, 0) << w;
   EXPECT_LT(max_speed, 0.5);
   EXPECT_NEAR(d->qpos[2], z0, 0.02);
+}
+
+// The character file binds to its model through the project's own loader, which
+// validates it (every joint in a group, pairs alike, one force-limited motor per joint).
+TEST_P(Characters3d, BindsThroughTheCharacterFile) {
+  const Expect& e = GetParam();
+  auto spec = std::make_shared<diverse::CharacterSpec>(
+      diverse::load_character_file(asset(e.name, ".toml")));
+  EXPECT_EQ(spec->root, diverse::RootKind::kFree);
+  EXPECT_FALSE(spec->has_shape());
+  Model model(spec->model);
+  ASSERT_NE(model.m, nullptr);
+  const diverse::Character body = diverse::bind_character(spec, model.m, spec->model);
+  EXPECT_EQ(body.dof(), e.internal_dof);
+  EXPECT_EQ(static_cast<int>(body.links.size()), e.links);
+  EXPECT_NEAR(body.total_mass, e.mass, 0.005 * e.mass);
+  EXPECT_NEAR(body.height, e.height, 0.01);
+  EXPECT_EQ(body.hands.size(), e.hands ? 2u : 0u);
+  EXPECT_GE(body.find_group(diverse::JointRole::kHip, diverse::JointPlane::kSagittal), 0);
+  EXPECT_GE(body.find_group(diverse::JointRole::kHip, diverse::JointPlane::kCoronal), 0);
+  EXPECT_GE(body.find_group(diverse::JointRole::kKnee), 0);
+  EXPECT_GE(body.find_group(diverse::JointRole::kAnkle), 0);
+  for (const diverse::CharacterJoint& j : body.joints) {
+    EXPECT_GT(j.torque_limit, 0) << j.name;
+    EXPECT_GT(body.groups[static_cast<size_t>(j.group)].kp, 0) << j.name;
+    EXPECT_GT(body.groups[static_cast<size_t>(j.group)].kd, 0) << j.name;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Both, Characters3d, ::testing::Values(kHuman, kRobot),
