@@ -22,6 +22,7 @@ void install_bench(CLI::App& app) {
     double seconds = 2.0;
     int threads = 0;
     bool json = false;
+    std::string character;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("bench", "Measure rollout throughput against raw mj_step");
@@ -30,9 +31,26 @@ void install_bench(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "Threads for the parallel figure (0 = one per core)")
       ->capture_default_str();
   cmd->add_flag("--json", args->json, "Print one JSON object");
+  cmd->add_option("--character", args->character,
+                  "A character with a free root (character file): measure it standing under stance control instead of a task");
   cmd->callback([args] {
     if (!(args->seconds > 0)) throw UserError("--seconds: expected a number > 0");
     if (args->threads < 0) throw UserError("--threads: expected an integer >= 0");
+    if (!args->character.empty()) {
+      const ThroughputReport r = measure_stance_throughput(args->character, {args->seconds, 1, 0});
+      if (args->json) {
+        nlohmann::json j = r.to_json();
+        j["character"] = args->character;
+        std::printf("%s\n", j.dump(2).c_str());
+        return;
+      }
+      std::printf("character %s standing, %d steps per rollout\n", args->character.c_str(), r.rollout_steps);
+      std::printf("  raw mj_step (the rollout's inputs replayed) %12.0f steps/s\n", r.raw_steps_per_second);
+      std::printf("  rollout (stance control + joint drive)      %12.0f steps/s   %.1f %% of raw\n",
+                  r.rollout_steps_per_second, 100.0 * r.rollout_ratio);
+      std::printf("  rollouts, 1 thread                          %12.1f /s\n", r.rollouts_per_second_1);
+      return;
+    }
     Task task = load_task(resolve_task_path(args->task));
     if (!std::filesystem::exists(task.m0))
       throw UserError(task.file + ": m0: " + task.m0 + " does not exist");

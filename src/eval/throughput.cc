@@ -4,9 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/rng.h"
 #include "core/thread_pool.h"
+#include "character/character.h"
+#include "control/controller.h"
+#include "control/stance_controller.h"
+#include "core/error.h"
+#include "physics/model.h"
 #include "physics/rollout.h"
 
 namespace diverse {
@@ -116,6 +122,75 @@ ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const Parame
   report.rollouts_per_second_1 = batch_rate(1);
   report.rollouts_per_second_n = batch_rate(report.threads);
   report.speedup = report.rollouts_per_second_n / report.rollouts_per_second_1;
+  return report;
+}
+
+namespace {
+
+class StandHooks : public StepHooks {
+ public:
+  StandHooks(StanceController& stance, JointDrive& drive) : stance_(stance), drive_(drive) {}
+  void control(mjModel* m, mjData* d) override {
+    if (first_) stance_.reset(m, d);
+    first_ = false;
+    stance_.control(m, d, drive_);
+  }
+  bool observe(const mjModel*, const mjData*) override { return false; }
+
+ private:
+  StanceController& stance_;
+  JointDrive& drive_;
+  bool first_ = true;
+};
+
+}  // namespace
+
+ThroughputReport measure_stance_throughput(const std::string& character_file,
+                                           const ThroughputOptions& options, double standing_seconds) {
+  const auto spec = std::make_shared<const CharacterSpec>(load_character_file(resolve_character_file(character_file)));
+  if (spec->root != RootKind::kFree) {
+    throw UserError(spec->file + ": root.kind: expected a free root for stance control (planar characters are "
+                                 "measured on a task: diverse bench TASK)");
+  }
+  const auto model = SharedModel::from_file(spec->model);
+  const Character body = bind_character(spec, model->get(), spec->model);
+  SimWorker worker(model);
+  const int steps = static_cast<int>(std::ceil(standing_seconds / model->get()->opt.timestep));
+  StanceController stance(body, model->get());
+  const std::vector<double> pose = stance.standing_pose(model->get());
+  auto stand = [&](StepRecorder* recorder) {
+    worker.reset();
+    std::copy(pose.begin(), pose.end(), worker.data()->qpos);
+    JointDrive drive = make_drive(body);
+    StanceController controller(body, model->get());
+    StandHooks hooks(controller, drive);
+    return run_rollout(worker, hooks, steps, drive, recorder);
+  };
+
+  ThroughputReport report;
+  StepRecorder record;
+  stand(&record);
+  report.rollout_steps = record.steps();
+  double raw = 0, rollout = 0;
+  long long rollouts = 0;
+  double rollout_time = 0;
+  for (int round = 0; round < 2; ++round) {
+    raw += raw_step_rate(model->get(), record, options.seconds / 2);
+    long long n = 0;
+    const auto start = Clock::now();
+    do {
+      n += stand(nullptr).steps;
+      ++rollouts;
+    } while (seconds_since(start) < options.seconds / 2);
+    const double elapsed = seconds_since(start);
+    rollout_time += elapsed;
+    rollout += static_cast<double>(n) / elapsed;
+  }
+  report.raw_steps_per_second = raw / 2;
+  report.rollout_steps_per_second = rollout / 2;
+  report.rollout_ratio = report.rollout_steps_per_second / report.raw_steps_per_second;
+  report.rollouts_per_second_1 = static_cast<double>(rollouts) / rollout_time;
+  report.threads = 1;
   return report;
 }
 

@@ -36,4 +36,13 @@ struct ThroughputReport {
 ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const ParameterSet& m0,
                                     const ThroughputOptions& options);
 
+// A character with a free root standing under stance control (control/stance_controller.h)
+// from its standing pose for `standing_seconds` of simulated time: rollout (stance control
+// through the joint drive) against raw mj_step replaying the same inputs, interleaved.
+// Fills the raw, rollout and rollouts/s (1 thread) figures. Throws UserError for a file
+// that is not a character with a free root.
+ThroughputReport measure_stance_throughput(const std::string& character_file,
+                                           const ThroughputOptions& options,
+                                           double standing_seconds = 3.0);
+
 }  // namespace diverse
