@@ -32,7 +32,7 @@ double thread_seconds() {
 }
 
 struct Fixture {
-  Fixture() : evaluator(load_task(kTask)), shapes(scene_xml(evaluator.task()), evaluator.task().model) {
+  Fixture() : evaluator(load_task(kTask)), shapes(scene_xml(evaluator.task()), *evaluator.task().character_spec, evaluator.task().model) {
     params = evaluator.load_parameters(evaluator.task().m0);
     // Median CPU time of a few M0 rollouts, for the ratio.
     auto worker = evaluator.make_worker();
@@ -58,9 +58,9 @@ Fixture& fixture() {
 }
 
 Eigen::VectorXd random_shape(const ShapeSpace& space, Rng& rng) {
-  Eigen::VectorXd scales(ShapeSpace::size());
-  for (int p = 0; p < ShapeSpace::size(); ++p) {
-    const ParamSpec& s = space.specs()[p];
+  Eigen::VectorXd scales(space.size());
+  for (int p = 0; p < space.size(); ++p) {
+    const ParamSpec& s = space.specs()[static_cast<size_t>(p)];
     scales[p] = s.lower + (s.upper - s.lower) * rng.uniform();
   }
   return scales;

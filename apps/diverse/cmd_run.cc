@@ -57,7 +57,8 @@ void install_run(CLI::App& app) {
                   "wja+shape (default: the task's)");
   cmd->add_option("--vary", args->vary,
                   "What the variations may change: control (the controller's parameters) or "
-                  "shape (the controller's parameters and the body's 10 link-length scales)")
+                  "shape (the controller's parameters and the body's link-length scales, the "
+                  "character file's [shape] parameters)")
       ->capture_default_str();
   cmd->add_option("--shape-weight", args->shape_weight,
                   "Weight of the shape distance (m) in a combined metric such as md+shape, in "

@@ -13,23 +13,6 @@
 namespace diverse {
 namespace {
 
-constexpr const char* kParamNames[kNumShapeParams] = {"pelvis", "abdomen", "chest",    "head",    "thigh",
-                                                      "shin",   "foot",    "upperarm", "forearm", "hand"};
-
-// The planar human's links and the parameter that scales each.
-struct LinkKind {
-  const char* name;
-  int param;
-};
-constexpr LinkKind kLinkKinds[] = {
-    {"pelvis", kShapePelvis},       {"abdomen", kShapeAbdomen},   {"chest", kShapeChest},
-    {"neck", kShapeHead},           {"head", kShapeHead},         {"thigh_l", kShapeThigh},
-    {"thigh_r", kShapeThigh},       {"shin_l", kShapeShin},       {"shin_r", kShapeShin},
-    {"foot_l", kShapeFoot},         {"foot_r", kShapeFoot},       {"upperarm_l", kShapeUpperarm},
-    {"upperarm_r", kShapeUpperarm}, {"forearm_l", kShapeForearm}, {"forearm_r", kShapeForearm},
-    {"hand_l", kShapeHand},         {"hand_r", kShapeHand}};
-constexpr int kNumLinks = static_cast<int>(sizeof(kLinkKinds) / sizeof(kLinkKinds[0]));
-
 // Shortest text that reads back as the same double.
 std::string format_number(double v) {
   char buffer[64];
@@ -204,12 +187,20 @@ std::vector<double> parse_numbers(const XmlAttr& a, const std::string& where) {
 
 }  // namespace
 
-const char* shape_param_name(int param) {
-  return (param >= 0 && param < kNumShapeParams) ? kParamNames[param] : "?";
+void require_shape(const CharacterSpec& spec) {
+  if (!spec.has_shape()) {
+    throw UserError(spec.file +
+                    ": shape: expected [shape] parameters in the character file for --vary shape "
+                    "(this character has none)");
+  }
+  if (spec.root != RootKind::kPlanar) {
+    throw UserError(spec.file + ": shape: expected a planar character (the shape rules scale the sagittal plane)");
+  }
 }
 
-ShapeSpace::ShapeSpace(std::string base_xml, std::string origin)
+ShapeSpace::ShapeSpace(std::string base_xml, const CharacterSpec& spec, std::string origin)
     : xml_(std::move(base_xml)), origin_(std::move(origin)) {
+  require_shape(spec);
   const std::vector<XmlElement> doc = XmlReader(xml_, origin_).read();
   auto child_named = [&](int parent, const char* name) {
     const std::vector<int>* list = nullptr;
@@ -244,13 +235,13 @@ ShapeSpace::ShapeSpace(std::string base_xml, std::string origin)
     if (g >= 0 && doc[g].attr("type") != nullptr) default_type = doc[g].attr("type")->value;
   }
 
-  // The root link: a body named "pelvis" directly in the world.
+  // The root link: the character file's root body, directly in the world.
   int root = -1;
   for (int c : doc[world].children) {
     const XmlAttr* name = doc[c].attr("name");
-    if (doc[c].name == "body" && name != nullptr && name->value == "pelvis") root = c;
+    if (doc[c].name == "body" && name != nullptr && name->value == spec.root_body) root = c;
   }
-  if (root < 0) throw UserError(origin_ + ": body 'pelvis': expected it in <worldbody>");
+  if (root < 0) throw UserError(origin_ + ": body '" + spec.root_body + "': expected it in <worldbody>");
 
   constexpr const char* kRotations[] = {"quat", "axisangle", "euler", "xyaxes", "zaxis"};
   auto where = [&](int e) {
@@ -295,20 +286,15 @@ ShapeSpace::ShapeSpace(std::string base_xml, std::string origin)
     check_plain(v.element);
     const XmlAttr* name = body.attr("name");
     const std::string body_name = name != nullptr ? name->value : "";
-    const LinkKind* kind = nullptr;
-    for (const LinkKind& k : kLinkKinds) {
-      if (body_name == k.name) kind = &k;
-    }
-    if (kind == nullptr) {
-      throw UserError(origin_ + ": body '" + body_name + "': expected one of the planar human's 17 links");
-    }
     for (const Link& l : links_) {
-      if (l.name == body_name) throw UserError(origin_ + ": body '" + body_name + "': expected it once");
+      if (!body_name.empty() && l.name == body_name)
+        throw UserError(origin_ + ": body '" + body_name + "': expected it once");
     }
     Link link;
     link.name = body_name;
-    link.param = kind->param;
     link.parent = v.parent_link;
+    link.foot = (v.parent_link >= 0 && links_[static_cast<size_t>(v.parent_link)].foot) ||
+                (!body_name.empty() && (body_name == spec.feet[0] || body_name == spec.feet[1]));
     const int self = static_cast<int>(links_.size());
     const std::string at = where(v.element);
     if (const XmlAttr* pos = body.attr("pos")) {
@@ -368,19 +354,41 @@ ShapeSpace::ShapeSpace(std::string base_xml, std::string origin)
     links_.push_back(std::move(link));
     for (auto it = child_bodies.rbegin(); it != child_bodies.rend(); ++it) stack.push_back({*it, self});
   }
-  if (static_cast<int>(links_.size()) != kNumLinks) {
-    for (const LinkKind& k : kLinkKinds) {
-      const bool found =
-          std::any_of(links_.begin(), links_.end(), [&](const Link& l) { return l.name == k.name; });
-      if (!found)
-        throw UserError(origin_ + ": body '" + std::string(k.name) + "': expected it inside 'pelvis'");
+  // The parameters' links, and the feet, must be links of the character.
+  auto find_link = [&](const std::string& name) {
+    for (size_t i = 0; i < links_.size(); ++i) {
+      if (links_[i].name == name) return static_cast<int>(i);
     }
+    return -1;
+  };
+  auto not_a_link = [&](const std::string& field, const std::string& name) {
+    const bool in_model = std::any_of(doc.begin(), doc.end(), [&](const XmlElement& e) {
+      return e.name == "body" && e.attr("name") != nullptr && e.attr("name")->value == name;
+    });
+    if (!in_model) {
+      throw UserError(spec.file + ": " + field + ": expected a body of the model " + origin_ +
+                      ", but it has no body '" + name + "'");
+    }
+    throw UserError(spec.file + ": " + field + ": expected a link of the character (a body inside '" +
+                    spec.root_body + "'), got '" + name + "'");
+  };
+  const int num_params = static_cast<int>(spec.shape.size());
+  for (int p = 0; p < num_params; ++p) {
+    for (const std::string& name : spec.shape[static_cast<size_t>(p)].links) {
+      const int i = find_link(name);
+      if (i < 0) not_a_link("shape.parameters[" + std::to_string(p) + "].links", name);
+      links_[static_cast<size_t>(i)].param = p;
+    }
+  }
+  for (const std::string& name : spec.feet) {
+    if (find_link(name) < 0) not_a_link("feet.bodies", name);
   }
   std::sort(edits_.begin(), edits_.end(), [](const Edit& a, const Edit& b) { return a.begin < b.begin; });
 
   // Base link lengths: to the farthest child origin, or the end link's own geometry.
-  base_lengths_.resize(kNumLinks);
-  for (int i = 0; i < kNumLinks; ++i) {
+  const int num_links = static_cast<int>(links_.size());
+  base_lengths_.resize(num_links);
+  for (int i = 0; i < num_links; ++i) {
     double length = 0;
     bool has_child = false;
     for (const Link& l : links_) {
@@ -394,50 +402,56 @@ ShapeSpace::ShapeSpace(std::string base_xml, std::string origin)
         length = std::max(length, p.sphere ? p.a.norm() + p.radius : (p.b - p.a).norm());
       }
     }
-    if (!(length > 0))
+    if (!(length > 0) && links_[i].param >= 0)
       throw UserError(origin_ + ": body '" + links_[i].name + "': expected a length > 0 to scale");
     base_lengths_[i] = length;
     link_names_.push_back(links_[i].name);
     link_params_.push_back(links_[i].param);
   }
 
-  // Ranges: the paper's [0.4, 2.5], raised where 0.4 would make a link shorter than
-  // 0.03 m; rounded up to 0.001 so that the bound prints exactly.
-  for (int p = 0; p < kNumShapeParams; ++p) {
+  // Ranges: the character file's [min, max] (the paper's [0.4, 2.5]), the lower bound
+  // raised where min would make a link shorter than the minimum link length; rounded up
+  // to 0.001 so that the bound prints exactly.
+  const double min_length = spec.shape_min_link_length;
+  for (int p = 0; p < num_params; ++p) {
+    const ShapeGroupSpec& group = spec.shape[static_cast<size_t>(p)];
     double shortest = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < kNumLinks; ++i) {
+    for (int i = 0; i < num_links; ++i) {
       if (links_[i].param == p) shortest = std::min(shortest, base_lengths_[i]);
     }
-    const double needed = std::ceil(kShapeMinLinkLength / shortest * 1000.0 - 1e-9) / 1000.0;
-    const double lower = std::max(kShapeScaleMin, needed);
-    if (lower > kShapeScaleMax) {
-      throw UserError(origin_ + ": shape." + kParamNames[p] + ": links too short to scale (below " +
-                      format_number(kShapeMinLinkLength / kShapeScaleMax) + " m)");
+    const double needed = std::ceil(min_length / shortest * 1000.0 - 1e-9) / 1000.0;
+    const double lower = std::max(group.min, needed);
+    if (lower > group.max) {
+      throw UserError(origin_ + ": shape." + group.name + ": links too short to scale (below " +
+                      format_number(min_length / group.max) + " m)");
     }
-    specs_.push_back(ParamSpec{std::string("shape.") + kParamNames[p], lower, kShapeScaleMax, "scale"});
+    specs_.push_back(ParamSpec{"shape." + group.name, lower, group.max, "scale"});
   }
   base_feet_low_ = extent(identity()).feet_low;
+  if (!std::isfinite(base_feet_low_)) {
+    throw UserError(spec.file + ": feet.bodies: expected a geom on the feet (the shaped character stands on them)");
+  }
 }
 
 Eigen::VectorXd ShapeSpace::scales_from(const ParameterSet& params) const {
-  Eigen::VectorXd scales(kNumShapeParams);
-  for (int p = 0; p < kNumShapeParams; ++p) scales[p] = params.get(specs_[p].name);
+  Eigen::VectorXd scales(size());
+  for (int p = 0; p < size(); ++p) scales[p] = params.get(specs_[static_cast<size_t>(p)].name);
   return scales;
 }
 
 Eigen::VectorXd ShapeSpace::link_lengths(const Eigen::VectorXd& scales) const {
-  Eigen::VectorXd lengths(kNumLinks);
-  for (int i = 0; i < kNumLinks; ++i) lengths[i] = scales[links_[i].param] * base_lengths_[i];
+  Eigen::VectorXd lengths(base_lengths_.size());
+  for (int i = 0; i < base_lengths_.size(); ++i) lengths[i] = scale(scales, i) * base_lengths_[i];
   return lengths;
 }
 
 void ShapeSpace::validate(const Eigen::VectorXd& scales, const std::string& origin) const {
-  if (scales.size() != kNumShapeParams) {
-    throw std::invalid_argument("ShapeSpace: expected " + std::to_string(kNumShapeParams) + " scales, got " +
+  if (scales.size() != size()) {
+    throw std::invalid_argument("ShapeSpace: expected " + std::to_string(size()) + " scales, got " +
                                 std::to_string(scales.size()));
   }
-  for (int p = 0; p < kNumShapeParams; ++p) {
-    const ParamSpec& s = specs_[p];
+  for (int p = 0; p < size(); ++p) {
+    const ParamSpec& s = specs_[static_cast<size_t>(p)];
     const double v = scales[p];
     if (!(v >= s.lower && v <= s.upper)) {
       throw UserError(origin + ": " + s.name + ": expected a scale in [" + format_number(s.lower) + ", " +
@@ -454,8 +468,8 @@ ShapeSpace::Extent ShapeSpace::extent(const Eigen::VectorXd& scales) const {
   std::vector<double> origin_z(links_.size(), 0.0);
   for (size_t i = 0; i < links_.size(); ++i) {
     const Link& l = links_[i];
-    if (l.parent >= 0) origin_z[i] = origin_z[l.parent] + scales[links_[l.parent].param] * l.offset[1];
-    const double r = scales[l.param];
+    if (l.parent >= 0) origin_z[i] = origin_z[l.parent] + scale(scales, l.parent) * l.offset[1];
+    const double r = scale(scales, static_cast<int>(i));
     for (const Primitive& p : l.primitives) {
       double low = 0, high = 0;
       if (p.sphere) {
@@ -467,7 +481,7 @@ ShapeSpace::Extent ShapeSpace::extent(const Eigen::VectorXd& scales) const {
       }
       low += origin_z[i];
       high += origin_z[i];
-      if (l.param == kShapeFoot) {
+      if (l.foot) {
         e.feet_low = std::min(e.feet_low, low);
       } else {
         e.other_low = std::min(e.other_low, low);
@@ -501,7 +515,7 @@ std::string ShapeSpace::xml(const Eigen::VectorXd& scales, const std::string& or
     out.append(xml_, copied, edit.begin - copied);
     copied = edit.end;
     values = edit.values;
-    const double r = scales[links_[edit.link].param];
+    const double r = scale(scales, edit.link);
     for (size_t k = 0; k < values.size(); ++k) {
       switch (edit.kind) {
         case EditKind::kSagittal:
@@ -533,8 +547,9 @@ std::shared_ptr<const SharedModel> ShapeSpace::compile(const Eigen::VectorXd& sc
   return SharedModel::from_xml(xml(scales, origin), origin_);
 }
 
-std::string shaped_model_xml(const std::string& base_xml, const Eigen::VectorXd& scales) {
-  return ShapeSpace(base_xml).xml(scales);
+std::string shaped_model_xml(const std::string& base_xml, const CharacterSpec& spec,
+                             const Eigen::VectorXd& scales) {
+  return ShapeSpace(base_xml, spec).xml(scales);
 }
 
 }  // namespace diverse

@@ -35,13 +35,18 @@ MotionProblem::MotionProblem(const TaskEvaluator& evaluator, DistanceSpec distan
     throw std::logic_error("MotionProblem: a distance on the shape needs vary_shape");
   if (distance_.combined() && distance_.metric == Metric::kShape)
     throw std::logic_error("MotionProblem: a combined distance needs a motion metric");
-  const ShapeSpace& shapes = evaluator.shapes();
-  base_scales_ = ShapeSpace::identity();
-  base_link_lengths_ = shapes.base_link_lengths();
+  // A character without shape parameters has no scales and no link lengths (its shape
+  // distance is 0); vary_shape needs them (TaskEvaluator::shapes() says so).
+  if (vary_shape_ || evaluator.has_shape()) {
+    const ShapeSpace& shapes = evaluator.shapes();
+    base_scales_ = shapes.identity();
+    base_link_lengths_ = shapes.base_link_lengths();
+  }
   parameters_ = evaluator.parameters();
   if (vary_shape_) {
-    Eigen::VectorXd lower(ShapeSpace::size());
-    for (int p = 0; p < ShapeSpace::size(); ++p) lower[p] = shapes.specs()[static_cast<std::size_t>(p)].lower;
+    const ShapeSpace& shapes = evaluator.shapes();
+    Eigen::VectorXd lower(shapes.size());
+    for (int p = 0; p < shapes.size(); ++p) lower[p] = shapes.specs()[static_cast<std::size_t>(p)].lower;
     parameters_ = evaluator.with_shape(parameters_, lower);
   }
   if (reference_.size() != parameters_.size())
@@ -64,7 +69,7 @@ ParameterSet MotionProblem::named(const Eigen::VectorXd& x) const {
     // lower + x (upper - lower) can round past a bound for x inside [0, 1]; a shape scale
     // past its bound would be refused, so such values go back on the bound.
     auto& values = p.values();
-    for (int i = p.size() - ShapeSpace::size(); i < p.size(); ++i) {
+    for (int i = p.size() - static_cast<int>(base_scales_.size()); i < p.size(); ++i) {
       const ParamSpec& s = p.specs()[static_cast<std::size_t>(i)];
       if (x[i] >= 0.0 && x[i] <= 1.0)
         values[static_cast<std::size_t>(i)] = std::clamp(values[static_cast<std::size_t>(i)], s.lower, s.upper);
@@ -85,10 +90,11 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
   } else {
     if (x.size() != dim()) throw std::logic_error("MotionProblem::evaluate: wrong dimension");
     const ParameterSet p = named(x);
-    const auto n = static_cast<std::size_t>(p.size() - ShapeSpace::size());
+    const int num_scales = static_cast<int>(base_scales_.size());
+    const auto n = static_cast<std::size_t>(p.size() - num_scales);
     const std::vector<double> control(p.values().begin(), p.values().begin() + static_cast<long>(n));
-    Eigen::VectorXd scales(ShapeSpace::size());
-    for (int k = 0; k < ShapeSpace::size(); ++k) scales[k] = p.values()[n + static_cast<std::size_t>(k)];
+    Eigen::VectorXd scales(num_scales);
+    for (int k = 0; k < num_scales; ++k) scales[k] = p.values()[n + static_cast<std::size_t>(k)];
     outcome->scales = scales;
     outcome->features.link_lengths = evaluator_->shapes().link_lengths(scales);
     int outside = -1;

@@ -9,8 +9,9 @@
 // computed on the same outcomes for reporting.
 //
 // Shape as a free parameter (paper section 8). With vary_shape a variation is the
-// controller's normalized parameters followed by the 10 normalized shape scales
-// (character/shape.h; every scale's range maps to [0, 1], so M0's body, scale 1, sits at
+// controller's normalized parameters followed by the normalized shape scales of the
+// character file's [shape] parameters (character/shape.h; the planar human has 10;
+// every scale's range maps to [0, 1], so M0's body, scale 1, sits at
 // (1 - lower) / (upper - lower)). The paper optimized 36 control parameters beside the
 // 10 shape parameters; we keep all of the controller's (jump controller: 90), as for
 // motion-only runs. Each sample builds its own body: the task's scene at that shape is
@@ -35,8 +36,10 @@ namespace diverse {
 // The outcome of one rollout.
 struct MotionOutcome : Outcome {
   MotionFeatures features;   // pose samples for the metrics (empty without a flight) and
-                             // the body's link lengths (always)
-  Eigen::VectorXd scales;    // the body's 10 shape scales (all 1 unless shape varies)
+                             // the body's link lengths (none for a character without
+                             // shape parameters)
+  Eigen::VectorXd scales;    // the body's shape scales (all 1 unless shape varies; none
+                             // for a character without shape parameters)
   bool fell = false;
   double landing_x = 0;      // m, mean foot x at rest (or at the end)
   double peak_com_z = 0;     // m

@@ -50,7 +50,7 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
     const Eigen::VectorXd scales = shapes.scales_from(parameters);
     const Eigen::VectorXd lengths = shapes.link_lengths(scales);
     nlohmann::json named = nlohmann::json::object();
-    for (int p = 0; p < ShapeSpace::size(); ++p) named[shapes.specs()[static_cast<size_t>(p)].name] = scales[p];
+    for (int p = 0; p < shapes.size(); ++p) named[shapes.specs()[static_cast<size_t>(p)].name] = scales[p];
     j["shape"] = {{"scales", named},
                   {"link_names", shapes.link_names()},
                   {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())}};

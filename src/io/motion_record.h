@@ -9,8 +9,8 @@
 //     "parameters": {"name": value, ...},          named controller parameters (and the
 //                                                  shape scales "shape.*" of a shaped body)
 //     "shape": {"scales": {...}, "link_names": [...], "link_lengths": [...]}   shaped bodies
-//                                                  only: the 10 scales and the 17 link
-//                                                  lengths (m) of the shape distance
+//                                                  only: the scales and the link lengths
+//                                                  (m) of the shape distance
 //     "constraint": {"total": C, "fell": false, "terms": [{"name", "violation", "penalty"}]},
 //     "summary": {peak COM height, feet position at the end, rotation, ...},
 //     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never

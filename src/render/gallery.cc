@@ -177,7 +177,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   const nlohmann::json vary = run.run.value("vary", nlohmann::json::array());
   const bool vary_shape = std::find(vary.begin(), vary.end(), "shape") != vary.end();
   ParameterSet like = evaluator.parameters();
-  if (vary_shape) like = evaluator.with_shape(like, ShapeSpace::identity());
+  if (vary_shape) like = evaluator.with_shape(like, evaluator.shapes().identity());
   const ParameterSet m0 = motion_parameters(like, run.motions[0].file);
 
   const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();

@@ -109,14 +109,15 @@ void write_run_outputs(const RunOutputs& o) {
                                   &records[i]);
   });
 
-  const ShapeSpace& shapes = o.evaluator.shapes();
+  // A character without shape parameters has no scales and no link lengths.
+  const ShapeSpace* shapes = o.evaluator.has_shape() ? &o.evaluator.shapes() : nullptr;
   nlohmann::json motions = nlohmann::json::array();
   for (std::size_t i = 0; i < count; ++i) {
     const auto& outcome = static_cast<const MotionOutcome&>(*result.outcomes[i]);
     const auto idx = static_cast<Eigen::Index>(i);
     nlohmann::json scales = nlohmann::json::object();
-    for (int p = 0; p < ShapeSpace::size(); ++p)
-      scales[shapes.specs()[static_cast<std::size_t>(p)].name] = outcome.scales[p];
+    for (int p = 0; p < outcome.scales.size(); ++p)
+      scales[shapes->specs()[static_cast<std::size_t>(p)].name] = outcome.scales[p];
     const Eigen::VectorXd& lengths = outcome.features.link_lengths;
     motions.push_back({{"index", i},
                        {"label", label(i)},
@@ -151,7 +152,7 @@ void write_run_outputs(const RunOutputs& o) {
       {"stop", to_string(result.stop)},
       {"D", result.score.D},
       {"all_satisfied", (result.score.constraint.array() == 0.0).all()},
-      {"link_names", shapes.link_names()},
+      {"link_names", shapes ? shapes->link_names() : std::vector<std::string>()},
       {"motions", motions},
       {"distances", distances},
       {"nudged_m0_distance", nudge_mean},

@@ -27,7 +27,7 @@ struct RunOutputs {
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"
 // the parameter groups), per motion its C, dmin, shape scales and link lengths (m,
-// "link_names" order), and "distances": the pairwise matrices over M0..MN of every motion
+// "link_names" order; none for a character without shape parameters), and "distances": the pairwise matrices over M0..MN of every motion
 // metric (hf, md, wja) and of the shape metric (all zero when the shape did not vary),
 // plus the objective's own matrix when it combines a motion metric with the shape.
 void write_run_outputs(const RunOutputs& outputs);

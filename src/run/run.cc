@@ -47,6 +47,8 @@ RunSetup make_setup(const std::string& task_path, const std::string& metric_name
   if (setup.distance.uses_shape() && !vary_shape)
     throw UserError("--metric: the " + to_string(setup.distance) +
                     " metric needs the shape parameters (--vary shape)");
+  // Before any work: a character without [shape] parameters cannot vary its shape.
+  if (vary_shape) require_shape(*task.character_spec);
   setup.options = options;
   if (setup.options.variations == 0) setup.options.variations = task.variations;
   if (setup.options.sigma0 == 0.0) setup.options.sigma0 = task.diversity.sigma0;
@@ -55,7 +57,7 @@ RunSetup make_setup(const std::string& task_path, const std::string& metric_name
                     " does not exist (create it with `diverse seed-motion " + task.name + "`)");
   setup.evaluator = std::make_unique<TaskEvaluator>(std::move(task));
   setup.m0 = setup.evaluator->load_parameters(setup.evaluator->task().m0);
-  if (vary_shape) setup.m0 = setup.evaluator->with_shape(setup.m0, ShapeSpace::identity());
+  if (vary_shape) setup.m0 = setup.evaluator->with_shape(setup.m0, setup.evaluator->shapes().identity());
   return setup;
 }
 

@@ -36,7 +36,8 @@ struct RunRequest {
   std::string task;                 // task name or path (resolve_task_path)
   std::string metric;               // "" = the task's metric; "shape", "md+shape", ...
   double shape_weight = 10.0;       // weight of the shape distance in "<metric>+shape"
-  bool vary_shape = false;          // the 10 shape scales are free parameters too
+  bool vary_shape = false;          // the shape scales are free parameters too (the
+                                    // character file's [shape] parameters)
   DiversityOptions options;         // variations = 0 means the task's N, sigma0 = 0 its sigma0
   std::filesystem::path out;        // run directory
   int threads = 0;                  // 0 = one per core

@@ -275,19 +275,27 @@ bool holds_shape(const ParameterSet& params) {
   return false;
 }
 
+bool TaskEvaluator::has_shape() const {
+  return task_.character_spec->has_shape() && task_.character_spec->root == RootKind::kPlanar;
+}
+
 const ShapeSpace& TaskEvaluator::shapes() const {
+  // A character without [shape] parameters (or not planar) cannot vary its shape: one line
+  // naming its character file, before any parsing.
+  require_shape(*task_.character_spec);
   std::call_once(shapes_->once, [this] {
-    shapes_->space = std::make_unique<ShapeSpace>(model_->xml(), task_.model);
+    shapes_->space = std::make_unique<ShapeSpace>(model_->xml(), *task_.character_spec, task_.model);
   });
   return *shapes_->space;
 }
 
 ParameterSet TaskEvaluator::with_shape(const ParameterSet& control, const Eigen::VectorXd& scales) const {
   const ShapeSpace& space = shapes();
-  if (scales.size() != ShapeSpace::size()) throw std::logic_error("with_shape: expected 10 scales");
+  if (scales.size() != space.size())
+    throw std::logic_error("with_shape: expected " + std::to_string(space.size()) + " scales");
   std::vector<ParamSpec> specs = control.specs();
   std::vector<double> values = control.values();
-  for (int p = 0; p < ShapeSpace::size(); ++p) {
+  for (int p = 0; p < space.size(); ++p) {
     specs.push_back(space.specs()[static_cast<size_t>(p)]);
     values.push_back(scales[p]);
   }
@@ -315,12 +323,18 @@ ParameterSet TaskEvaluator::load_shaped_parameters(const std::string& path) cons
   p.set_from_json(control, path);
   if (shape.empty()) return p;
   const ShapeSpace& space = shapes();
-  Eigen::VectorXd scales = ShapeSpace::identity();
+  Eigen::VectorXd scales = space.identity();
   for (const auto& [name, value] : shape.items()) {
     int index = -1;
-    for (int k = 0; k < ShapeSpace::size(); ++k)
+    for (int k = 0; k < space.size(); ++k)
       if (space.specs()[static_cast<size_t>(k)].name == name) index = k;
-    if (index < 0) throw_field_error(path, name, "expected a known shape parameter (shape.pelvis, ..., shape.hand)");
+    if (index < 0) {
+      const auto& specs = space.specs();
+      const std::string known = specs.size() == 1   ? specs.front().name
+                                : specs.size() == 2 ? specs.front().name + ", " + specs.back().name
+                                                    : specs.front().name + ", ..., " + specs.back().name;
+      throw_field_error(path, name, "expected a known shape parameter (" + known + ")");
+    }
     const ParamSpec& s = space.specs()[static_cast<size_t>(index)];
     if (!value.is_number()) {
       std::ostringstream range;

@@ -67,7 +67,7 @@ struct Evaluation {
 // The task's scene with the character at one body shape (character/shape.h). Immutable:
 // threads share it, each with its own SimWorker on `model`.
 struct ShapedScene {
-  Eigen::VectorXd scales;                    // the 10 scales, ShapeSpace order
+  Eigen::VectorXd scales;                    // the shape scales, ShapeSpace order
   Eigen::VectorXd link_lengths;              // m, one per link, ShapeSpace::link_names() order
   StandingShape standing;                    // start height and ground clearance
   std::shared_ptr<const SharedModel> model;  // the shaped scene; model->xml() is its exact text
@@ -115,10 +115,15 @@ class TaskEvaluator {
   // Body shape (character/shape.h, docs/shapes.md). Masses, joint ranges and torque
   // limits never change with the shape; link lengths, inertias and the start height do.
   //
+  // True when the character can vary its shape: its character file has [shape]
+  // parameters and its root is planar (require_shape passes).
+  bool has_shape() const;
   // The shape space of the task's scene, parsed on first use (thread-safe). Throws
-  // UserError if the character is not the shape-parameterized planar human.
+  // UserError if the character cannot vary its shape (require_shape: no [shape]
+  // parameters in its character file, or not planar) or its model is outside the shape
+  // rules.
   const ShapeSpace& shapes() const;
-  // `control` (the controller's parameters) followed by the 10 shape scales.
+  // `control` (the controller's parameters) followed by the shape scales.
   ParameterSet with_shape(const ParameterSet& control, const Eigen::VectorXd& scales) const;
   // The controller's values (parameters() order) of a set that may also hold shape scales.
   std::vector<double> control_values(const ParameterSet& params) const;

@@ -20,7 +20,7 @@ const std::string kTask = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.to
 struct Fixture {
   Fixture() : evaluator(load_task(kTask)) {
     m0 = evaluator.load_parameters(evaluator.task().m0);
-    shaped_m0 = evaluator.with_shape(m0, ShapeSpace::identity());
+    shaped_m0 = evaluator.with_shape(m0, evaluator.shapes().identity());
   }
   TaskEvaluator evaluator;
   ParameterSet m0, shaped_m0;
@@ -29,6 +29,15 @@ struct Fixture {
 Fixture& fixture() {
   static Fixture f;
   return f;
+}
+
+// The index of shape parameter "shape.NAME" of the task's shape space.
+int shape_param(const Fixture& f, const std::string& name) {
+  const auto& specs = f.evaluator.shapes().specs();
+  for (std::size_t p = 0; p < specs.size(); ++p)
+    if (specs[p].name == "shape." + name) return static_cast<int>(p);
+  ADD_FAILURE() << "no shape parameter " << name;
+  return 0;
 }
 
 const MotionOutcome& motion(const std::shared_ptr<const Outcome>& o) {
@@ -58,15 +67,15 @@ TEST(ShapeProblem, ParametersAreTheControllersFollowedByTheShape) {
   EXPECT_EQ(problem.parameters().specs().back().name, "shape.hand");
   // M0's body: scale 1, normalized (1 - lower) / (upper - lower).
   const Eigen::VectorXd x = problem.reference();
-  EXPECT_DOUBLE_EQ(x[control + kShapeThigh], (1 - 0.4) / 2.1);
-  EXPECT_DOUBLE_EQ(x[control + kShapeHead], (1 - 0.429) / (2.5 - 0.429));
+  EXPECT_DOUBLE_EQ(x[control + shape_param(f, "thigh")], (1 - 0.4) / 2.1);
+  EXPECT_DOUBLE_EQ(x[control + shape_param(f, "head")], (1 - 0.429) / (2.5 - 0.429));
   const ParameterSet named = problem.named(x);
-  for (int p = 0; p < ShapeSpace::size(); ++p)
+  for (int p = 0; p < f.evaluator.shapes().size(); ++p)
     EXPECT_NEAR(named.values()[static_cast<std::size_t>(control + p)], 1.0, 1e-15);
   // A scale at the top of its range comes back exactly on the bound.
   Eigen::VectorXd top = x;
-  top.tail(ShapeSpace::size()).setOnes();
-  for (int p = 0; p < ShapeSpace::size(); ++p) EXPECT_EQ(problem.named(top).values()[static_cast<std::size_t>(control + p)], 2.5);
+  top.tail(f.evaluator.shapes().size()).setOnes();
+  for (int p = 0; p < f.evaluator.shapes().size(); ++p) EXPECT_EQ(problem.named(top).values()[static_cast<std::size_t>(control + p)], 2.5);
 
   // A distance on the shape needs the shape to vary.
   EXPECT_THROW(MotionProblem(f.evaluator, DistanceSpec{Metric::kShape, 0.0}, f.m0.normalized(), 1, false),
@@ -95,11 +104,11 @@ TEST(ShapeProblem, M0sOwnShapeReproducesTheMotionOnlyProblemExactly) {
 TEST(ShapeProblem, OutcomesArePureFunctionsOfXWhateverTheWorkerRanBefore) {
   Fixture& f = fixture();
   const MotionProblem problem(f.evaluator, DistanceSpec{Metric::kShape, 0.0}, f.shaped_m0.normalized(), 2, true);
-  Eigen::VectorXd longer_legs = ShapeSpace::identity();
-  longer_legs[kShapeShin] = 1.05;
-  longer_legs[kShapeFoot] = 1.1;
-  Eigen::VectorXd shorter_arms = ShapeSpace::identity();
-  shorter_arms[kShapeForearm] = 0.8;
+  Eigen::VectorXd longer_legs = f.evaluator.shapes().identity();
+  longer_legs[shape_param(f, "shin")] = 1.05;
+  longer_legs[shape_param(f, "foot")] = 1.1;
+  Eigen::VectorXd shorter_arms = f.evaluator.shapes().identity();
+  shorter_arms[shape_param(f, "forearm")] = 0.8;
   const Eigen::VectorXd xa = shaped_x(f, longer_legs), xb = shaped_x(f, shorter_arms);
 
   const auto first = problem.evaluate(xa, 0);   // worker 0 builds shape a
@@ -122,9 +131,9 @@ TEST(ShapeProblem, OutcomesArePureFunctionsOfXWhateverTheWorkerRanBefore) {
 
 TEST(ShapeProblem, ABodyWhoseHandsStartBelowTheFloorFallsAtOnce) {
   Fixture& f = fixture();
-  Eigen::VectorXd scales = ShapeSpace::identity();
-  scales[kShapeUpperarm] = 2.5;
-  scales[kShapeForearm] = 2.5;
+  Eigen::VectorXd scales = f.evaluator.shapes().identity();
+  scales[shape_param(f, "upperarm")] = 2.5;
+  scales[shape_param(f, "forearm")] = 2.5;
   const auto scene = f.evaluator.shaped_scene(scales);
   ASSERT_TRUE(scene->below_floor());
   SimWorker worker(scene->model);
@@ -147,7 +156,7 @@ TEST(ShapeProblem, ABodyWhoseHandsStartBelowTheFloorFallsAtOnce) {
   EXPECT_LE(e.stats.steps, 1);
 
   // The base body stands: its hands are above the floor.
-  EXPECT_FALSE(f.evaluator.shaped_scene(ShapeSpace::identity())->below_floor());
+  EXPECT_FALSE(f.evaluator.shaped_scene(f.evaluator.shapes().identity())->below_floor());
 }
 
 TEST(ShapeProblem, OutOfTheBoxSamplesFailAndCombinedDistancesAddTheWeightedShape) {
@@ -160,8 +169,8 @@ TEST(ShapeProblem, OutOfTheBoxSamplesFailAndCombinedDistancesAddTheWeightedShape
   EXPECT_TRUE(failed->failed);
   EXPECT_EQ(failed->constraint, 3 * f.evaluator.task().constraints.fall_penalty);
 
-  Eigen::VectorXd scales = ShapeSpace::identity();
-  scales[kShapeChest] = 1.1;
+  Eigen::VectorXd scales = f.evaluator.shapes().identity();
+  scales[shape_param(f, "chest")] = 1.1;
   const auto a = problem.evaluate(problem.reference(), 0);
   const auto b = problem.evaluate(shaped_x(f, scales), 0);
   const double md = problem.distance(*a, *b, Metric::kMassDistance);

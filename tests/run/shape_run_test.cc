@@ -73,8 +73,8 @@ TEST(ShapeRun, EveryVariationMeetsTheTaskOnItsOwnBodyAndReplaysFromItsOwnModel) 
     EXPECT_EQ(m["constraint"], 0.0);
 
     // Scales within their ranges, link lengths the scaled links and never below 3 cm.
-    Eigen::VectorXd scales(ShapeSpace::size());
-    for (int p = 0; p < ShapeSpace::size(); ++p) {
+    Eigen::VectorXd scales(shapes.size());
+    for (int p = 0; p < shapes.size(); ++p) {
       const ParamSpec& spec = shapes.specs()[static_cast<std::size_t>(p)];
       scales[p] = m["shape_scales"][spec.name].get<double>();
       EXPECT_GE(scales[p], spec.lower) << spec.name;
@@ -87,7 +87,7 @@ TEST(ShapeRun, EveryVariationMeetsTheTaskOnItsOwnBodyAndReplaysFromItsOwnModel) 
     EXPECT_GE(L.minCoeff(), 0.03);
     lengths.push_back(L);
     if (i == 0) {
-      EXPECT_EQ(scales, ShapeSpace::identity());
+      EXPECT_EQ(scales, evaluator().shapes().identity());
     }
 
     // Its own model: the exact shaped text, masses as the task's body, replays exactly.
@@ -103,7 +103,7 @@ TEST(ShapeRun, EveryVariationMeetsTheTaskOnItsOwnBodyAndReplaysFromItsOwnModel) 
 
     // The motion file names the shape beside the controller's parameters.
     const nlohmann::json motion = read_json(motion_file);
-    for (int p = 0; p < ShapeSpace::size(); ++p) {
+    for (int p = 0; p < shapes.size(); ++p) {
       const std::string& name = shapes.specs()[static_cast<std::size_t>(p)].name;
       EXPECT_EQ(motion["parameters"][name].get<double>(), scales[p]) << name;
     }
@@ -191,9 +191,12 @@ TEST(ShapeParams, AShapeGivenByHandIsSimulatedOnItsBodyAndReplaysExactly) {
   const CliResult r = run_cli("simulate " + kTask + " --params " + params.string() + " --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("shape: pelvis 1 abdomen 1 chest 1 head 1 thigh 1.1"), std::string::npos) << r.output;
-  Eigen::VectorXd scales = ShapeSpace::identity();
-  scales[kShapeThigh] = 1.1;
-  scales[kShapeHand] = 0.7;
+  Eigen::VectorXd scales = evaluator().shapes().identity();
+  const auto& specs = evaluator().shapes().specs();
+  for (std::size_t p = 0; p < specs.size(); ++p) {
+    if (specs[p].name == "shape.thigh") scales[static_cast<Eigen::Index>(p)] = 1.1;
+    if (specs[p].name == "shape.hand") scales[static_cast<Eigen::Index>(p)] = 0.7;
+  }
   EXPECT_EQ(read_file(out / "model.xml"), evaluator().shapes().xml(scales));
   const CliResult replay = run_cli("replay " + (out / "motion.json").string());
   EXPECT_EQ(replay.status, 0) << replay.output;
