@@ -64,8 +64,15 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
   j["summary"] = summary_json(e.summary);
 
   nlohmann::json phases = nlohmann::json::array();
-  for (std::size_t p = 0; p < e.phases.names.size(); ++p)
-    phases.push_back({{"name", e.phases.names[p]}, {"begin", e.phases.begin[p]}});
+  for (std::size_t p = 0; p < e.phases.names.size(); ++p) {
+    nlohmann::json phase = {{"name", e.phases.names[p]}, {"begin", e.phases.begin[p]}};
+    // The events of the motion: which phases begin at take-off, the peak and touch-down.
+    const int i = static_cast<int>(p);
+    if (i == e.phases.rise) phase["event"] = "takeoff";
+    if (i == e.phases.fall) phase["event"] = "peak";
+    if (i == e.phases.land) phase["event"] = "landing";
+    phases.push_back(std::move(phase));
+  }
   j["phases"] = phases;
 
   nlohmann::json samples = nlohmann::json::array();

@@ -61,13 +61,21 @@ RunMotion read_motion(const fs::path& dir, std::size_t i, const nlohmann::json& 
     throw UserError(m.file.string() + ": replay.nq: " + std::to_string(m.record.nq) +
                     " does not match the model " + m.model_path.string() + " (nq " +
                     std::to_string(m.model->get()->nq) + ")");
-  // Phase begin times by name, so a file with other phases still reads.
+  // Phase names and begin times as the controller reported them, and which phases begin
+  // at take-off, the peak and touch-down ("event"; files without it name them rise, fall
+  // and land).
   if (motion.contains("phases") && motion["phases"].is_array()) {
     for (const auto& phase : motion["phases"]) {
+      if (!phase.is_object()) throw_field_error(m.file.string(), "phases", "an array of objects");
       const std::string name = phase.value("name", "");
-      for (int p = 0; p < kNumJumpPhases; ++p)
-        if (name == jump_phase_name(p))
-          m.phases.begin[static_cast<std::size_t>(p)] = phase.value("begin", -1.0);
+      const std::string event = phase.value("event", name == "rise" ? "takeoff" : name == "fall" ? "peak" : name == "land" ? "landing" : "");
+      const int index = static_cast<int>(m.phases.names.size());
+      if (event == "takeoff") m.phases.rise = index;
+      if (event == "peak") m.phases.fall = index;
+      if (event == "landing") m.phases.land = index;
+      m.phases.names.push_back(name);
+      const auto begin = phase.find("begin");
+      m.phases.begin.push_back(begin != phase.end() && begin->is_number() ? begin->get<double>() : -1.0);
     }
   }
   return m;
