@@ -94,7 +94,7 @@ void run(const SeedArgs& args) {
   const std::string partial_path = stem + ".partial.json";
   // The command as the user gave it: --start only when it was given (the task's [seed]
   // base otherwise, named relative to the task file).
-  std::string command = "diverse seed-motion " + task.name;
+  std::string command = "diverse seed-motion " + args.task;
   if (!args.start.empty()) command += " --start " + args.start;
   if (args.generations > 0) command += " --generations " + std::to_string(args.generations);
   if (args.sigma > 0) {
@@ -142,7 +142,7 @@ void run(const SeedArgs& args) {
   if (!met)
     throw UserError(task.file + ": no motion meeting the task was found (best C = " +
                     std::to_string(r.constraint) + "); continue with `diverse seed-motion " +
-                    task.name + " --start " + out + "`");
+                    args.task + " --start " + out + "`");
 }
 
 void install(CLI::App& app) {

@@ -12,8 +12,9 @@ namespace diverse {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr const char* kRoleNames[] = {"hip",      "knee",  "ankle", "toe",  "shoulder",
-                                      "elbow",    "wrist", "waist", "neck"};
+constexpr const char* kRoleNames[] = {"hip",   "knee",  "ankle", "toe",  "shoulder", "elbow",
+                                      "wrist", "waist", "neck",  "tail", "other"};
+constexpr int kNumRoles = static_cast<int>(sizeof kRoleNames / sizeof kRoleNames[0]);
 constexpr const char* kPlaneNames[] = {"sagittal", "coronal", "transverse"};
 
 std::string role_list() {
@@ -24,7 +25,7 @@ std::string role_list() {
 
 JointRole parse_role(const TomlReader& r) {
   const std::string v = r.string("role");
-  for (int i = 0; i < 9; ++i)
+  for (int i = 0; i < kNumRoles; ++i)
     if (v == kRoleNames[i]) return static_cast<JointRole>(i);
   r.fail("role", "expected one of " + role_list() + ", got \"" + v + "\"");
 }

@@ -33,7 +33,8 @@
 namespace diverse {
 
 // What a joint does in the body; controllers look joints up by role (and plane).
-enum class JointRole { kHip, kKnee, kAnkle, kToe, kShoulder, kElbow, kWrist, kWaist, kNeck };
+// kTail and kOther are for joints no controller treats specially (a tail, a fin, ...).
+enum class JointRole { kHip, kKnee, kAnkle, kToe, kShoulder, kElbow, kWrist, kWaist, kNeck, kTail, kOther };
 // The plane a hinge turns in, in the character's own frame at its standing pose:
 // sagittal (pitch, about the lateral axis), coronal (roll, about the forward axis),
 // transverse (yaw, about the vertical axis).

@@ -235,7 +235,7 @@ TEST(CharacterErrors, FileErrors) {
   Edited role("role");
   role.toml("role = \"elbow\"", "role = \"funny_bone\"");
   EXPECT_EQ(role.error(), role.file() + ": groups[6].role: expected one of hip, knee, ankle, toe, shoulder, elbow, "
-                                        "wrist, waist, neck, got \"funny_bone\"");
+                                        "wrist, waist, neck, tail, other, got \"funny_bone\"");
   Edited wja("wja");
   wja.toml("wja = 1.0\nkp = 40.0", "wja = -1\nkp = 40.0");
   EXPECT_EQ(wja.error(), wja.file() + ": groups[6].wja: expected a number in [0, 100], got -1");
