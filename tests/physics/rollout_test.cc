@@ -159,7 +159,8 @@ TEST_F(TaskRollout, PoseSamplesCoverBothAirbornePhases) {
     const double a = p.phase == 0 ? takeoff : peak, b = p.phase == 0 ? peak : land;
     EXPECT_NEAR(p.time, a + p.phase_time * (b - a), 1e-12);
     EXPECT_EQ(p.link_com.cols(), 17);
-    EXPECT_EQ(p.angles.size(), 17);
+    EXPECT_EQ(p.angles.size(), 16);  // the joints; the root's orientation is p.root
+    EXPECT_NEAR(p.root.norm(), 1.0, 1e-12);
   }
   EXPECT_NEAR(evaluator_->link_masses().sum(), 80.0, 1e-9);
   // The COM is higher mid-flight than at take-off.

@@ -116,8 +116,8 @@ TEST(SeedMotion, LandingShiftIsTheLargerOfTouchdownAndRest) {
   EXPECT_EQ(landing_shift(a, a), 0.0);
 }
 
-// An earlier jump_high input motion meets its task at both timesteps, but lands 4 cm
-// apart at the two (more than the 3 cm an input motion is searched for within): to the
+// A perturbation of jump_high's input motion meets its task at both timesteps, but lands
+// 11 cm apart at the two (more than the 3 cm an input motion is searched for within): to the
 // search it is not yet an input motion, and neither is any candidate of one generation
 // close around it.
 TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
