@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "support/text_files.h"
 #include "physics/model.h"
 #include "support/cli.h"
 
@@ -19,17 +20,8 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kCharacters = std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/";
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
+using test_files::read_text;
+using test_files::write_text;
 
 // Replaces the first occurrence of `from` (which must occur) with `to`.
 std::string edit(std::string text, const std::string& from, const std::string& to) {

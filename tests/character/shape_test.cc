@@ -19,6 +19,7 @@
 
 #include "character/character.h"
 #include "core/error.h"
+#include "support/text_files.h"
 #include "core/rng.h"
 #include "physics/mujoco_guard.h"
 #include "support/cli.h"
@@ -53,17 +54,8 @@ double anchor_distance(const Character& body, const std::string& a, const std::s
   return std::sqrt(d2);
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
+using test_files::read_text;
+using test_files::write_text;
 
 const ShapeSpace& space() {
   static const ShapeSpace s(read_text(kModelPath), *human_spec(), kModelPath);
