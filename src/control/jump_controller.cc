@@ -211,7 +211,9 @@ JumpController::JumpController(const Character& body, const JumpControllerConfig
 }
 
 void JumpController::set_parameters(const std::vector<double>& values) {
-  if (values.size() != parameter_specs(body_).size()) throw std::logic_error("JumpController: parameter count");
+  // Per phase a target per posed group and kp, kd of hip, knee, ankle; then six more.
+  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 6;
+  if (values.size() != count) throw std::logic_error("JumpController: parameter count");
   size_t k = 0;
   for (int p = 0; p < kNumJumpPhases; ++p) {
     for (size_t g = 0; g < posed_.size(); ++g) pose_[p][g] = values[k++];
