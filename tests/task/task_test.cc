@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "task/constraints.h"
+#include "task/evaluate.h"
 
 namespace diverse {
 namespace {
@@ -60,6 +61,29 @@ class TaskFileTest : public ::testing::Test {
     return text;
   }
 };
+
+// The controller is a plug-in chosen by name; an unknown name lists the known ones, and a
+// controller that cannot drive the character says why before any simulation.
+TEST_F(TaskFileTest, ControllerTypeIsLookedUpAndCheckedAgainstTheCharacter) {
+  EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"walk9\"")),
+            ": controller.type: expected one of \"jump2d\", got \"walk9\"");
+  EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"jump2d\"\nbounce = 2")),
+            ": controller.bounce: expected no such key (unknown key; known keys: type, landing_control, "
+            "landing_height, extend_timeout, balance_kp, balance_kd, balance_max_force, gravity_compensation)");
+  const Task planar = load_task(write(valid_text()));
+  EXPECT_EQ(planar.controller_type->name(), std::string("jump2d"));
+  EXPECT_EQ(planar.character_spec->name, "human2d");
+  // The 3D human has a free root: jump2d refuses it when the task is evaluated.
+  const std::string path = write(replace(valid_text(), "human2d.xml", "human3d.toml"));
+  try {
+    TaskEvaluator ev(load_task(path));
+    ADD_FAILURE() << "jump2d accepted a free-root character";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": controller.type: expected a character with a planar root for "
+                                            "\"jump2d\", but the character " + std::string(DIVERSE_SOURCE_DIR) +
+                                            "/assets/characters/human3d.toml has a free root");
+  }
+}
 
 TEST_F(TaskFileTest, CommittedTasksParse) {
   for (const char* name : {"backflip", "jump_forward", "jump_onto", "jump_over", "jump_high"}) {
