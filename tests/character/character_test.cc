@@ -260,5 +260,26 @@ TEST(CharacterErrors, TheCommandLineSaysSoAndExitsWithTwo) {
   EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
 }
 
+TEST(CharacterCli, DescribesAValidCharacterAndRefusesABrokenOne) {
+  const cli_test::CliResult human = cli_test::run_cli("character " + kCharacters + "human3d.toml");
+  ASSERT_EQ(human.status, 0) << human.output;
+  EXPECT_NE(human.output.find("root free in 'pelvis' (unactuated)"), std::string::npos) << human.output;
+  EXPECT_NE(human.output.find("15 links, 80.000 kg, 1.800 m tall standing, 24 internal DOF"), std::string::npos)
+      << human.output;
+  EXPECT_NE(human.output.find("no shape parameters (control-only diversity)"), std::string::npos);
+  const cli_test::CliResult planar = cli_test::run_cli("character " + kCharacters + "human2d.xml");
+  ASSERT_EQ(planar.status, 0) << planar.output;
+  EXPECT_NE(planar.output.find("17 links, 80.000 kg, 1.600 m tall standing, 16 internal DOF in 10 groups"),
+            std::string::npos)
+      << planar.output;
+  EXPECT_NE(planar.output.find("shape.thigh"), std::string::npos);
+  Edited c("cli_character");
+  c.xml("<motor name=\"tau_knee_l\" joint=\"knee_l\"", "<motor name=\"tau_knee_l\" joint=\"knee_l\" gear=\"3\"");
+  const std::string expected = c.error();
+  const cli_test::CliResult broken = cli_test::run_cli("character " + c.file());
+  EXPECT_EQ(broken.status, 2);
+  EXPECT_EQ(broken.output, "diverse: error: " + expected + "\n");
+}
+
 }  // namespace
 }  // namespace diverse
