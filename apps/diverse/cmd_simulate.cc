@@ -1,7 +1,7 @@
 // `diverse simulate TASK [--params FILE] --out DIR`: simulates one parameter set of a
 // task (by default its input motion M0), prints every constraint term, and writes
 // DIR/motion.json with the exact-replay record (src/io/motion_record.h), DIR/model.xml
-// (as MuJoCo saves it, or the exact shaped text), and DIR/filmstrip.png with the
+// (the exact MJCF text the motion ran on), and DIR/filmstrip.png with the
 // character at the phase events. A parameter file may also give the body shape as scales
 // "shape.NAME" (docs/shapes.md; a scale left out is 1); a motion file of a run with
 // varying shape is such a file.

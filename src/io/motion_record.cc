@@ -117,11 +117,11 @@ Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& para
   options.recorder = &record;
   std::shared_ptr<const SharedModel> model;
   const Evaluation e = evaluator.evaluate_named(parameters, options, &model);
-  if (holds_shape(parameters)) {
-    write_file_atomic(info.model_path, model->xml());
-  } else {
-    model->save_xml(info.model_path.string());
-  }
+  // The exact MJCF text the model was compiled from: loaded by any MuJoCo program it
+  // compiles to the same numbers, so the recorded inputs replay bit for bit. MuJoCo's own
+  // writer (mj_saveLastXML) keeps 6 significant digits, which a shaped body or a rotated
+  // frame (the bird robot's legs: 7e-5 of drift in 3 s) does not survive.
+  write_file_atomic(info.model_path, model->xml());
   write_json_atomic(json_path, motion_record_json(evaluator, parameters, e, record, info, json_path));
   if (record_out) *record_out = std::move(record);
   return e;

@@ -13,13 +13,16 @@
 //                                                  (m) of the shape distance
 //     "constraint": {"total": C, "fell": false, "terms": [{"name", "violation", "penalty"}]},
 //     "summary": {peak COM height, feet position at the end, rotation, ...},
-//     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never
+//     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never;
+//                                                  "event": "takeoff", "peak" or "landing"
+//                                                  on the phases those events begin
 //     "pose_samples": {"link_names", "angle_names", "link_masses",
 //                      "samples": [{"phase", "phase_time", "time", "link_com", "angles"}]},
 //     "replay": {
-//       "model": "../model/m1.xml",   path of the MJCF, relative to this file: as MuJoCo
-//                                     saves it, or for a shaped body the exact shaped text
-//                                     (MuJoCo's writer keeps 6 digits: docs/shapes.md)
+//       "model": "../model/m1.xml",   path of the MJCF, relative to this file: the exact
+//                                     text the motion ran on (MuJoCo's own writer keeps 6
+//                                     digits, which rotated frames and shaped bodies do
+//                                     not survive: docs/shapes.md)
 //       "timestep": 0.002, "nq": 19, "nu": 16,
 //       "qpos0": [...], "qvel0": [...],            initial state
 //       "damped_dofs": [...],                      dofs whose dof_damping the controller sets

@@ -12,7 +12,7 @@
 namespace diverse {
 namespace {
 
-// mj_loadXML and mj_saveLastXML share process-global parser state.
+// mj_loadXML keeps process-global parser state.
 std::mutex& loader_mutex() {
   static std::mutex mutex;
   return mutex;
@@ -71,17 +71,6 @@ std::shared_ptr<const SharedModel> SharedModel::from_file(const std::string& pat
 
 SharedModel::~SharedModel() {
   if (model_ != nullptr) mj_deleteModel(model_);
-}
-
-void SharedModel::save_xml(const std::string& path) const {
-  std::lock_guard<std::mutex> lock(loader_mutex());
-  std::string error;
-  mjModel* model = compile_locked(xml_, &error);
-  if (model == nullptr) throw UserError(origin_ + ": MuJoCo cannot compile the model: " + error);
-  char message[1000] = "";
-  const int ok = mj_saveLastXML(path.c_str(), model, message, sizeof(message));
-  mj_deleteModel(model);
-  if (!ok) throw UserError(path + ": MuJoCo cannot save the model: " + message);
 }
 
 SimWorker::SimWorker(std::shared_ptr<const SharedModel> shared) : shared_(std::move(shared)) {

@@ -34,9 +34,6 @@ class SharedModel {
   const std::string& xml() const { return xml_; }
   const std::string& origin() const { return origin_; }
 
-  // Writes the model as MuJoCo saves it (mj_saveLastXML after recompiling the same text;
-  // the "last XML" is process-global, so this holds the loader lock). Throws UserError.
-  void save_xml(const std::string& path) const;
 
  private:
   SharedModel() = default;
