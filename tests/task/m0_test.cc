@@ -70,7 +70,7 @@ struct Neighbourhood {
 };
 const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"backflip", {0.01, 32, 3}},
-    {"jump_forward", {0.02, 8, 1}},
+    {"jump_forward", {0.01, 32, 12}},
     {"jump_onto", {0.02, 8, 1}},
     {"jump_over", {0.01, 32, 2}},
     {"jump_high", {0.02, 8, 1}}};
