@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/toml_reader.h"
+#include "physics/model.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
@@ -152,25 +153,6 @@ class Binder {
   std::string origin_;
 };
 
-// Lowest and highest world z of a geom in the current kinematics.
-void geom_z_extent(const mjModel* m, const mjData* d, int g, double* lo, double* hi) {
-  const double* p = d->geom_xpos + 3 * g;
-  const double* R = d->geom_xmat + 9 * g;
-  const double* s = m->geom_size + 3 * g;
-  double half = 0;
-  switch (m->geom_type[g]) {
-    case mjGEOM_SPHERE: half = s[0]; break;
-    case mjGEOM_CAPSULE: half = std::fabs(R[8]) * s[1] + s[0]; break;
-    case mjGEOM_CYLINDER: half = std::fabs(R[8]) * s[1] + s[0] * std::sqrt(std::max(0.0, 1 - R[8] * R[8])); break;
-    case mjGEOM_BOX: half = std::fabs(R[6]) * s[0] + std::fabs(R[7]) * s[1] + std::fabs(R[8]) * s[2]; break;
-    case mjGEOM_ELLIPSOID:
-      half = std::sqrt(R[6] * R[6] * s[0] * s[0] + R[7] * R[7] * s[1] * s[1] + R[8] * R[8] * s[2] * s[2]);
-      break;
-    default: half = m->geom_rbound[g]; break;
-  }
-  *lo = p[2] - half;
-  *hi = p[2] + half;
-}
 
 }  // namespace
 

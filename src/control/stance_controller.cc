@@ -111,6 +111,17 @@ double axis_moment(const double* a, const double* r, const double* f) {
   return dot3(a, c);
 }
 
+// Gravity compensation of one hinge: the torque about its axis that holds up the links it
+// carries, a . ((c_sub - p) x m_sub g z), with c_sub and m_sub its subtree's COM and mass.
+double gravity_torque(const mjModel* m, const mjData* d, const CharacterJoint& j, double gravity) {
+  const double* a = d->xaxis + 3 * j.joint;
+  const double* p = d->xanchor + 3 * j.joint;
+  const double* c = d->subtree_com + 3 * j.body;
+  const double r[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
+  const double f[3] = {0, 0, m->body_subtreemass[j.body] * gravity};
+  return axis_moment(a, r, f);
+}
+
 // Rotation vector (world frame) of the rotation that takes orientation q to `target`.
 void rotation_error(const double* target, const double* q, double* e) {
   double inv[4], dq[4];
@@ -441,14 +452,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     double u = g.kp * (targets_[static_cast<size_t>(k)] - d->qpos[j.qpos]);
     const int leg = leg_of_[static_cast<size_t>(k)];
     const bool in_stance = leg >= 0 && stance_[static_cast<size_t>(leg)];
-    if (gains_.gravity_compensation && !in_stance) {
-      const double* a = d->xaxis + 3 * j.joint;
-      const double* p = d->xanchor + 3 * j.joint;
-      const double* c = d->subtree_com + 3 * j.body;
-      const double r[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-      const double f[3] = {0, 0, m->body_subtreemass[j.body] * gravity_};
-      u += axis_moment(a, r, f);
-    }
+    if (gains_.gravity_compensation && !in_stance) u += gravity_torque(m, d, j, gravity_);
     u_[static_cast<size_t>(k)] = u;
     kd_[static_cast<size_t>(k)] = g.kd;
   }
@@ -487,13 +491,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
       const double* a = d->xaxis + 3 * j.joint;
       double u = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
-      if (gains_.gravity_compensation) {
-        const double* p = d->xanchor + 3 * j.joint;
-        const double* c = d->subtree_com + 3 * j.body;
-        const double r[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-        const double f[3] = {0, 0, m->body_subtreemass[j.body] * gravity_};
-        u += axis_moment(a, r, f);
-      }
+      if (gains_.gravity_compensation) u += gravity_torque(m, d, j, gravity_);
       u_[static_cast<size_t>(k)] = u;
       kd_[static_cast<size_t>(k)] = g.kd;
     }

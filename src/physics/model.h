@@ -67,4 +67,8 @@ class SimWorker {
   mjData* data_ = nullptr;
 };
 
+// Lowest and highest world z (m) of geom `g` in the kinematics of `d`: exact for spheres,
+// capsules, cylinders, boxes and ellipsoids, the bounding sphere for other types.
+void geom_z_extent(const mjModel* m, const mjData* d, int g, double* lo, double* hi);
+
 }  // namespace diverse

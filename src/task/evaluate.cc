@@ -166,16 +166,16 @@ TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
   model_ = SharedModel::from_xml(scene_xml(task_), task_.model);
   body_ = std::make_unique<Character>(bind_character(task_.character_spec, model_->get(), task_.model));
   task_.controller_type->check(*body_, task_.file);
+  specs_ = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   if (task_.constraints.clearance) {
     obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());
   }
 }
 
 ParameterSet TaskEvaluator::parameters() const {
-  const auto specs = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   std::vector<double> values;
-  for (const ParamSpec& s : specs) values.push_back(s.lower);
-  return ParameterSet(specs, values);
+  for (const ParamSpec& s : specs_) values.push_back(s.lower);
+  return ParameterSet(specs_, values);
 }
 
 namespace {
@@ -303,7 +303,7 @@ ParameterSet TaskEvaluator::with_shape(const ParameterSet& control, const Eigen:
 }
 
 std::vector<double> TaskEvaluator::control_values(const ParameterSet& params) const {
-  const auto specs = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
+  const std::vector<ParamSpec>& specs = specs_;
   std::vector<double> values;
   values.reserve(specs.size());
   for (const ParamSpec& s : specs) values.push_back(params.get(s.name));

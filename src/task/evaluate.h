@@ -157,6 +157,7 @@ class TaskEvaluator {
   Task task_;
   std::shared_ptr<const SharedModel> model_;
   std::unique_ptr<Character> body_;
+  std::vector<ParamSpec> specs_;  // the controller's parameters for body_, named once
   int obstacle_geom_ = -1;
 
   // The rollout of evaluate(), on `body` (the task's, or a shaped scene's).

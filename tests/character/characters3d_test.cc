@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "character/character.h"
+#include "physics/model.h"
 
 namespace {
 
@@ -53,33 +54,6 @@ struct Model {
   Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 };
-
-// Lowest and highest world z of a geom at the current kinematics.
-void z_extent(const mjModel* m, const mjData* d, int g, double* lo, double* hi) {
-  const double* p = d->geom_xpos + 3 * g;
-  const double* R = d->geom_xmat + 9 * g;
-  const double* s = m->geom_size + 3 * g;
-  double half = m->geom_rbound[g];
-  switch (m->geom_type[g]) {
-    case mjGEOM_SPHERE:
-      half = s[0];
-      break;
-    case mjGEOM_CAPSULE:
-      half = std::fabs(R[8]) * s[1] + s[0];
-      break;
-    case mjGEOM_BOX:
-      half = std::fabs(R[6]) * s[0] + std::fabs(R[7]) * s[1] + std::fabs(R[8]) * s[2];
-      break;
-    case mjGEOM_ELLIPSOID:
-      half = std::sqrt(R[6] * R[6] * s[0] * s[0] + R[7] * R[7] * s[1] * s[1] +
-                       R[8] * R[8] * s[2] * s[2]);
-      break;
-    default:
-      break;
-  }
-  *lo = p[2] - half;
-  *hi = p[2] + half;
-}
 
 // The character file's groups: joint names, and for each its group's plane.
 struct Groups {
@@ -146,7 +120,7 @@ TEST_P(Characters3d, LinksDofMassAndHeightAreThePapers) {
   for (int g = 0; g < m->ngeom; ++g) {
     if (m->body_rootid[m->geom_bodyid[g]] != root || m->geom_bodyid[g] == 0) continue;
     double lo = 0, hi = 0;
-    z_extent(m, model.d, g, &lo, &hi);
+    diverse::geom_z_extent(m, model.d, g, &lo, &hi);
     low = std::min(low, lo);
     high = std::max(high, hi);
   }
@@ -174,7 +148,7 @@ TEST_P(Characters3d, FeetAreBoxesFlatOnTheFloor) {
       const double* R = model.d->geom_xmat + 9 * g;
       EXPECT_NEAR(R[8], 1.0, 1e-9) << foot << ": sole horizontal";
       double lo = 0, hi = 0;
-      z_extent(m, model.d, g, &lo, &hi);
+      diverse::geom_z_extent(m, model.d, g, &lo, &hi);
       EXPECT_NEAR(lo, 0.0, 0.001) << foot;
       EXPECT_EQ(m->geom_condim[g], 3);
       EXPECT_GE(m->geom_friction[3 * g], 0.9);
