@@ -6,7 +6,8 @@ packages=(
   libmujoco-dev libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libosmesa6-dev ffmpeg fonts-dejavu-core
-  jq  # scripts/reproduce-table1.sh reads the runs' summary.json
+  jq  # scripts/reproduce-table1.sh and scripts/kill-resume.sh read the runs' summary.json
+  clang libclang-rt-14-dev  # the libFuzzer targets (fuzz/) and their test (docs/reliability.md)
   chromium
 )
 # The gallery page (web/) is built with node and npm and tested in Chromium; a node that is

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "eval/throughput.h"
 #include "task/task.h"
@@ -27,9 +28,12 @@ void install_bench(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("bench", "Measure rollout throughput against raw mj_step");
   cmd->add_option("task", args->task, "Task name or path")->capture_default_str();
-  cmd->add_option("--seconds", args->seconds, "Seconds per measurement")->capture_default_str();
+  cmd->add_option("--seconds", args->seconds, "Seconds per measurement")
+      ->capture_default_str()
+      ->check(number_in(0, 3600, Bound::kOpen));
   cmd->add_option("--threads", args->threads, "Threads for the parallel figure (0 = one per core)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, kMaxThreads));
   cmd->add_flag("--json", args->json, "Print one JSON object");
   cmd->add_option("--character", args->character,
                   "A character with a free root (character file): measure it standing under stance control instead of a task");

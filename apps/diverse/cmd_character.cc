@@ -14,6 +14,7 @@
 
 #include "character/character.h"
 #include "command.h"
+#include "options.h"
 #include "physics/model.h"
 
 namespace diverse::cli {

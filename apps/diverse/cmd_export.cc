@@ -8,6 +8,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "io/bvh.h"
 #include "render/run_media.h"

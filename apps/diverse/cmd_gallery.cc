@@ -10,6 +10,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "render/gallery.h"
 
@@ -29,6 +30,7 @@ void install(CLI::App& app) {
   cmd->add_flag("--no-paths", args->no_paths,
                 "Leave out the optimization paths (they are simulated from the run's task file)");
   cmd->add_option("--threads", args->threads, "Simulation threads (0 = one per core)")
+      ->check(integer_in(0, kMaxThreads))
       ->capture_default_str();
   cmd->callback([args] {
     if (args->threads < 0) throw UserError("--threads: expected 0 or more, got " + std::to_string(args->threads));

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "render/run_media.h"
 

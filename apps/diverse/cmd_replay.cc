@@ -12,6 +12,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/drive.h"

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "io/files.h"
 
@@ -27,6 +28,11 @@ void install_report(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("report", "A Markdown table of finished runs");
   cmd->add_option("runs", *runs, "Run directories")->required();
   cmd->callback([runs] {
+    // Every directory is checked before the table starts, so an error is the only output.
+    for (const std::string& dir : *runs) {
+      if (!std::filesystem::exists(std::filesystem::path(dir) / "summary.json"))
+        throw UserError(dir + ": not a finished run (no summary.json)");
+    }
     std::printf(
         "| run | task | metric | strategy | seed | generations | minutes | D | C of M1..MN | "
         "min d among M0..MN | mean d among M1..MN | d(M0, nudged M0) |\n"

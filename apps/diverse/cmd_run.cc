@@ -10,6 +10,8 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
+#include "options.h"
 #include "core/error.h"
 #include "metric/metric.h"
 #include "optimize/diversity.h"
@@ -19,6 +21,7 @@ namespace diverse::cli {
 namespace {
 
 constexpr const char* kDefaultTask = "jump_high";
+constexpr double kMaxCheckpointSeconds = 86400;
 
 struct RunArgs {
   std::string task = kDefaultTask;
@@ -50,7 +53,8 @@ void install_run(CLI::App& app) {
       "run", "Find N diverse variations of a task's input motion (default task: jump_high)");
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or path to a task file")
       ->capture_default_str();
-  cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)");
+  cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)")
+      ->check(integer_in(1, kMaxVariations));
   cmd->add_option("--metric", args->metric,
                   "Distance metric: hf, md or wja (motion), shape (body shape; needs --vary shape), "
                   "or a motion metric plus the weighted shape distance: hf+shape, md+shape, "
@@ -63,9 +67,14 @@ void install_run(CLI::App& app) {
   cmd->add_option("--shape-weight", args->shape_weight,
                   "Weight of the shape distance (m) in a combined metric such as md+shape, in "
                   "units of the motion metric per metre")
-      ->capture_default_str();
-  cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")->capture_default_str();
-  cmd->add_option("--generations", args->generations, "Generation limit")->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in(0, 1e9, Bound::kOpen));
+  cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")
+      ->capture_default_str()
+      ->check(number_in(0, 1e9));
+  cmd->add_option("--generations", args->generations, "Generation limit")
+      ->capture_default_str()
+      ->check(integer_in(1, kMaxGenerations));
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
       ->capture_default_str();
   cmd->add_option("--constraints", args->constraints,
@@ -76,39 +85,36 @@ void install_run(CLI::App& app) {
                   "Where a variation stands between its steps: best-sample (its best sample "
                   "so far) or mean (its CMA mean, as in the paper)")
       ->capture_default_str();
-  cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str()->check(unsigned_integer());
   cmd->add_option("--threads", args->threads, "Worker threads (0 = one per core)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, kMaxThreads));
   cmd->add_option("--popsize", args->popsize, "CMA-ES samples per generation (lambda)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(2, kMaxPopsize));
   cmd->add_option("--sigma0", args->sigma0,
                   "Initial CMA-ES step, in normalized units (default: the task's, 0.1 unless "
-                  "its [diversity] table says otherwise)");
+                  "its [diversity] table says otherwise)")
+      ->check(number_in(0, 1, Bound::kOpen));
   cmd->add_option("--window", args->window,
                   "Stop when D improves by less than --epsilon over this many generations (0 = off)")
-      ->capture_default_str();
-  cmd->add_option("--epsilon", args->epsilon, "See --window")->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, kMaxGenerations));
+  cmd->add_option("--epsilon", args->epsilon, "See --window")
+      ->capture_default_str()
+      ->check(number_in(0, 1e12));
   cmd->add_option("--out", args->out, "Run directory (default: runs/<task>)");
   cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
   cmd->add_flag("--quiet", args->quiet, "No progress output");
   cmd->add_flag("--no-render", args->no_render, "Do not write filmstrip.png");
   cmd->add_option("--checkpoint-seconds", args->checkpoint_seconds,
                   "Wall seconds between checkpoints (0 = every generation)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in(0, kMaxCheckpointSeconds));
   cmd->callback([args] {
     const RunArgs& a = *args;
-    if (a.n < 0) throw UserError("--n: expected an integer >= 1, got " + std::to_string(a.n));
-    if (!(a.k >= 0.0)) throw UserError("--k: expected a number >= 0, got " + std::to_string(a.k));
-    if (a.generations < 1)
-      throw UserError("--generations: expected an integer >= 1, got " + std::to_string(a.generations));
-    if (a.popsize < 2)
-      throw UserError("--popsize: expected an integer >= 2, got " + std::to_string(a.popsize));
-    if (a.sigma0 != 0.0 && !(a.sigma0 > 0.0 && a.sigma0 <= 1.0))
-      throw UserError("--sigma0: expected a number in (0, 1], got " + std::to_string(a.sigma0));
-    if (a.window < 0) throw UserError("--window: expected an integer >= 0");
-    if (!(a.epsilon >= 0.0)) throw UserError("--epsilon: expected a number >= 0");
-    if (!(a.checkpoint_seconds >= 0.0))
-      throw UserError("--checkpoint-seconds: expected a number >= 0");
+    // Ranges are checked by the options' validators (options.h); n = 0 and sigma0 = 0
+    // (never accepted from the command line) stand for the task's own values.
     if (a.vary != "control" && a.vary != "shape")
       throw UserError("--vary: expected control or shape, got '" + a.vary + "'");
     if (!a.metric.empty()) parse_distance(a.metric, a.shape_weight);
@@ -151,15 +157,16 @@ void install_resume(CLI::App& app) {
   auto no_render = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
   cmd->add_option("dir", *dir, "Run directory")->required();
-  cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")->capture_default_str();
+  cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")
+      ->capture_default_str()
+      ->check(integer_in(0, kMaxThreads));
   cmd->add_flag("--quiet", *quiet, "No progress output");
   cmd->add_flag("--no-render", *no_render, "Do not write filmstrip.png");
   cmd->add_option("--checkpoint-seconds", *checkpoint_seconds,
                   "Wall seconds between checkpoints (0 = every generation)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(number_in(0, kMaxCheckpointSeconds));
   cmd->callback([dir, threads, quiet, checkpoint_seconds, no_render] {
-    if (!(*checkpoint_seconds >= 0.0))
-      throw UserError("--checkpoint-seconds: expected a number >= 0");
     resume_run(*dir, *threads, *quiet, *checkpoint_seconds, !*no_render);
   });
 }

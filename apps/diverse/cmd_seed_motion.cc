@@ -14,6 +14,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "io/files.h"
 #include "core/error.h"
 #include "task/evaluate.h"
@@ -152,31 +153,31 @@ void install(CLI::App& app) {
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or task file")->required();
   cmd->add_option("--start", args->start, "Starting parameters (default: the task's seed.base)");
   cmd->add_option("--out", args->out, "Output file (default: the task's m0 file)");
-  cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 256));
+  cmd->add_option("--threads", args->threads, "Worker threads")->check(integer_in(1, kMaxThreads));
   cmd->add_option("--generations", args->generations,
                   "CMA-ES generations per stage (default: the task's seed.generations)")
-      ->check(CLI::Range(1, 100000));
+      ->check(integer_in(1, 100000));
   cmd->add_option("--sigma", args->sigma,
                   "Initial CMA-ES step, normalized (default: the task's seed.sigma)")
-      ->check(CLI::Range(1e-6, 1.0));
+      ->check(number_in(1e-6, 1.0));
   cmd->add_option("--perturbations", args->perturbations,
                   "Robustness term: perturbed rollouts per candidate (0 = off)")
-      ->check(CLI::Range(0, 1000));
+      ->check(integer_in(0, 1000));
   cmd->add_option("--perturbation-sigma", args->perturbation_sigma,
                   "Robustness term: their standard deviation, in normalized units")
-      ->check(CLI::Range(1e-6, 1.0));
+      ->check(number_in(1e-6, 1.0));
   cmd->add_option("--min-flight-rotation", args->min_flight_rotation_deg,
                   "Require this root rotation (degrees, backwards positive) between take-off and "
                   "touch-down while searching (0 = none)")
-      ->check(CLI::Range(0.0, 720.0));
+      ->check(number_in(0, 720));
   cmd->add_flag("--robustness-check", args->robustness_check,
                 "Measure a motion instead of searching (default: the task's M0, or --start)");
   cmd->add_option("--check-sigmas", args->check_sigmas,
                   "Robustness check: perturbation sizes, normalized (default 0.02 0.05)")
-      ->check(CLI::Range(1e-6, 1.0));
+      ->check(number_in(1e-6, 1.0));
   cmd->add_option("--check-samples", args->check_samples,
                   "Robustness check: perturbations per size (default 32)")
-      ->check(CLI::Range(1, 100000));
+      ->check(integer_in(1, 100000));
   cmd->callback([args] { run(*args); });
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "io/motion_record.h"
 #include "render/film_strip.h"

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "command.h"
+#include "options.h"
 #include "core/error.h"
 #include "core/thread_pool.h"
 #include "io/files.h"
@@ -207,21 +208,30 @@ void add_toy(CLI::App& app) {
   auto args = std::make_shared<ToyArgs>();
   CLI::App* cmd = app.add_subcommand(
       "toy", "Diversity optimization of points in a 2-D region (paper figure 2)");
-  cmd->add_option("--k", args->k, "weight K of the dmin term (>= 0)")->capture_default_str();
-  cmd->add_option("--n", args->n, "number of synthesized points N (>= 1)")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "run seed")->capture_default_str();
+  cmd->add_option("--k", args->k, "weight K of the dmin term (>= 0)")
+      ->capture_default_str()
+      ->check(number_in(0, 1e9));
+  cmd->add_option("--n", args->n, "number of synthesized points N (>= 1)")
+      ->capture_default_str()
+      ->check(integer_in(1, kMaxVariations));
+  cmd->add_option("--seed", args->seed, "run seed")->capture_default_str()->check(unsigned_integer());
   cmd->add_option("--out", args->out, "output directory")->required();
-  cmd->add_option("--generations", args->generations, "generation limit")->capture_default_str();
+  cmd->add_option("--generations", args->generations, "generation limit")
+      ->capture_default_str()
+      ->check(integer_in(1, kMaxGenerations));
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
       ->capture_default_str();
   cmd->add_option("--constraints", args->constraints,
                   "dominant (a violating sample ranks below every feasible one) or penalty "
                   "(eq. 1 literally: -C inside D)")
       ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "worker threads")->capture_default_str();
+  cmd->add_option("--threads", args->threads, "worker threads")
+      ->capture_default_str()
+      ->check(integer_in(1, kMaxThreads));
   cmd->add_option("--seeds", args->seeds,
                   "run this many seeds (SEED, SEED+1, ...) into OUT/seed-<s>/ and summarize them")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(1, 10000));
   cmd->add_flag("!--no-paths", args->paths, "leave the optimization paths out of toy.svg");
   cmd->callback([args] { run_toy(*args); });
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -26,6 +27,25 @@ bool register_command(int order, Installer installer) {
   return true;
 }
 
+// Errors are one line: a line break or other control character that came from a file
+// (a TOML string, a JSON key) is printed escaped.
+std::string one_line(const char* message) {
+  std::string out;
+  for (const char* c = message; *c != '\0'; ++c) {
+    const auto u = static_cast<unsigned char>(*c);
+    if (u == '\n') {
+      out += "\\n";
+    } else if (u < 0x20 || u == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    } else {
+      out += *c;
+    }
+  }
+  return out;
+}
+
 }  // namespace diverse::cli
 
 int main(int argc, char** argv) {
@@ -39,6 +59,22 @@ int main(int argc, char** argv) {
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [order, install] : commands) install(app);
 
+  // A first argument that is neither an option nor a subcommand is named in the error
+  // (CLI11 would only say that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    std::string names;
+    const CLI::App& top = app;
+    for (const CLI::App* sub : top.get_subcommands([](const CLI::App*) { return true; })) {
+      known = known || sub->check_name(argv[1]);
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::fprintf(stderr, "diverse: error: %s: expected a subcommand (%s)\n",
+                   diverse::cli::one_line(argv[1]).c_str(), names.c_str());
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -48,13 +84,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "diverse: error: %s\n", e.what());
+    std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
     return 2;
   } catch (const diverse::UserError& e) {
-    std::fprintf(stderr, "diverse: error: %s\n", e.what());
+    std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "diverse: internal error: %s\n", e.what());
+    std::fprintf(stderr, "diverse: internal error: %s\n", diverse::cli::one_line(e.what()).c_str());
     return 3;
   }
   return 0;

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/text_file.h"
 #include "core/toml_reader.h"
 #include "physics/model.h"
 
@@ -207,7 +208,10 @@ std::string resolve_character_file(const std::string& path) {
     }
     return toml.lexically_normal().string();
   }
-  if (!fs::is_regular_file(p)) throw UserError(path + ": cannot read the character file");
+  if (!fs::is_regular_file(p)) {
+    read_text_file(path, "character");  // throws, naming why (missing, a directory, ...)
+    throw UserError(path + ": cannot read the character file");
+  }
   return p.lexically_normal().string();
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/text_file.h"
 
 namespace diverse {
 
@@ -149,15 +150,17 @@ class TomlReader {
   std::string path_;
 };
 
-// Parses a TOML file; UserError "PATH: cannot read the WHAT file" or "PATH: line N:
+// Parses a TOML file; UserError "PATH: cannot read the WHAT file (REASON)" or "PATH: line N:
 // expected valid TOML (...)".
 inline toml::table parse_toml_file(const std::string& path, const std::string& what) {
+  const std::string text = read_text_file(path, what);
   toml::table root;
   try {
-    root = toml::parse_file(path);
+    root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     std::string description(e.description());
-    if (e.source().begin.line == 0) throw UserError(path + ": cannot read the " + what + " file");
+    for (char& c : description)
+      if (c == '\n' || c == '\r') c = ' ';
     throw UserError(path + ": line " + std::to_string(e.source().begin.line) +
                     ": expected valid TOML (" + description + ")");
   }

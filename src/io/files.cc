@@ -1,15 +1,18 @@
 #include "io/files.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/text_file.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
@@ -53,6 +56,16 @@ void write_file_atomic(const fs::path& path, const std::string& contents) {
     ::unlink(tmp.c_str());
     throw UserError(path.string() + ": cannot write (" + why + ")");
   }
+  // The rename itself is durable only once the directory is: without this, a power loss
+  // shortly after could bring back the old file (or none).
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0 || ::fsync(dfd) != 0) {
+    const std::string why = errno_text();
+    if (dfd >= 0) ::close(dfd);
+    throw UserError(path.string() + ": written, but its directory cannot be synced (" + why + ")");
+  }
+  ::close(dfd);
 }
 
 void write_json_atomic(const fs::path& path, const nlohmann::json& value) {
@@ -60,29 +73,39 @@ void write_json_atomic(const fs::path& path, const nlohmann::json& value) {
 }
 
 std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const bool exists = fs::exists(path);
-    throw UserError(path.string() + ": cannot read (" +
-                    (exists ? std::string("permission denied or not a file")
-                            : std::string("no such file")) +
-                    ")");
-  }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  return read_text_file(path.string(), "");
 }
 
 nlohmann::json read_json(const fs::path& path) {
   const std::string text = read_file(path);
   try {
     return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for 1e999
     std::string detail = e.what();
     if (const auto pos = detail.find("parse error"); pos != std::string::npos)
       detail = detail.substr(pos);
     throw UserError(path.string() + ": not valid JSON (" + detail + ")");
   }
+}
+
+int remove_stale_temporaries(const fs::path& dir) {
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const auto tmp = name.rfind(".tmp.");
+    if (tmp == std::string::npos || !entry.is_regular_file(ec)) continue;
+    const std::string rest = name.substr(tmp + 5);  // PID.N
+    const auto dot = rest.find('.');
+    if (dot == std::string::npos || dot == 0 ||
+        rest.find_first_not_of("0123456789.") != std::string::npos)
+      continue;
+    const long pid = std::strtol(rest.substr(0, dot).c_str(), nullptr, 10);
+    if (pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)) {
+      if (fs::remove(entry.path(), ec)) ++removed;
+    }
+  }
+  return removed;
 }
 
 void ensure_writable_directory(const fs::path& dir) {

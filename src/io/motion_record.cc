@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/error.h"
 #include "io/files.h"
@@ -127,10 +128,24 @@ Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& para
   return e;
 }
 
+namespace {
+
+// An integer in [lo, hi] (a float, a bool or a string is not one).
+int strict_int(const nlohmann::json& j, int lo, int hi) {
+  if (!j.is_number_integer()) throw std::invalid_argument("not an integer");
+  const long long v = j.get<long long>();
+  if (j.is_number_unsigned() && j.get<unsigned long long>() > static_cast<unsigned long long>(hi))
+    throw std::invalid_argument("out of range");
+  if (v < lo || v > hi) throw std::invalid_argument("out of range");
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
 StepRecorder read_replay_record(const nlohmann::json& motion, const fs::path& json_path,
                                 fs::path* model_path) {
   const std::string where = json_path.string();
-  if (!motion.is_object() || motion.value("format", "") != "diverse.motion")
+  if (!motion.is_object() || !motion.contains("format") || motion["format"] != "diverse.motion")
     throw UserError(where + ": format: expected \"diverse.motion\" (a motion file written by "
                             "`diverse simulate` or `diverse run`)");
   if (!motion.contains("replay") || !motion["replay"].is_object())
@@ -144,21 +159,23 @@ StepRecorder read_replay_record(const nlohmann::json& motion, const fs::path& js
     if (model_path) *model_path = base / r.at("model").get<std::string>();
     field = "timestep";
     record.timestep = r.at("timestep").get<double>();
+    if (!(record.timestep > 0 && record.timestep <= 1)) throw std::invalid_argument("timestep");
     field = "nq";
-    record.nq = r.at("nq").get<int>();
+    record.nq = strict_int(r.at("nq"), 1, 100000);
     field = "nu";
-    record.nu = r.at("nu").get<int>();
+    record.nu = strict_int(r.at("nu"), 0, 100000);
     field = "qpos0";
     record.qpos0 = r.at("qpos0").get<std::vector<double>>();
     field = "qvel0";
     record.qvel0 = r.at("qvel0").get<std::vector<double>>();
     field = "damped_dofs";
-    record.damped_dofs = r.at("damped_dofs").get<std::vector<int>>();
+    for (const auto& dof : r.at("damped_dofs")) record.damped_dofs.push_back(strict_int(dof, 0, 100000));
     record.ndamp = static_cast<int>(record.damped_dofs.size());
     field = "damping";
     for (const auto& change : r.at("damping")) {
       StepRecorder::DampingChange c;
-      c.step = change.at("step").get<int>();
+      c.step = strict_int(change.at("step"), 0, std::numeric_limits<int>::max());
+      if (!record.damping.empty() && c.step < record.damping.back().step) throw std::invalid_argument("order");
       c.values = change.at("values").get<std::vector<double>>();
       if (static_cast<int>(c.values.size()) != record.ndamp) throw std::invalid_argument("size");
       record.damping.push_back(std::move(c));
@@ -194,6 +211,13 @@ double replay_motion_file(const fs::path& json_path, int* steps) {
   if (m->nq != record.nq || m->nu != record.nu || m->nv != static_cast<int>(record.qvel0.size())) {
     mj_deleteModel(m);
     throw UserError(json_path.string() + ": replay: nq/nu do not match the model " + model_path.string());
+  }
+  for (int dof : record.damped_dofs) {
+    if (dof >= m->nv) {
+      mj_deleteModel(m);
+      throw UserError(json_path.string() + ": replay.damped_dofs: expected dof indices below the model's nv (" +
+                      std::to_string(m->nv) + "), got " + std::to_string(dof));
+    }
   }
   if (std::fabs(m->opt.timestep - record.timestep) > 0) {
     mj_deleteModel(m);

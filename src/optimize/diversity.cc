@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -16,6 +17,25 @@ constexpr int kCheckpointVersion = 2;
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+// An integer field of a saved state, checked to be an integer (not a float or a bool)
+// that fits T: a float cast to an int out of its range is undefined behaviour.
+template <class T>
+T integer_from_json(const nlohmann::json& j, const char* field) {
+  bool fits = false;
+  if (j.is_number_unsigned()) {
+    fits = j.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<T>::max());
+  } else if (j.is_number_integer()) {
+    const long long v = j.get<long long>();
+    fits = v >= static_cast<long long>(std::numeric_limits<T>::min()) &&
+           (v < 0 || static_cast<unsigned long long>(v) <= static_cast<unsigned long long>(std::numeric_limits<T>::max()));
+  }
+  if (!fits)
+    throw UserError(std::string(field) + ": expected an integer in [" +
+                    std::to_string(std::numeric_limits<T>::min()) + ", " +
+                    std::to_string(std::numeric_limits<T>::max()) + "], got " + j.dump());
+  return j.get<T>();
 }
 
 Eigen::VectorXd vector_from_json(const nlohmann::json& j) {
@@ -141,13 +161,17 @@ void validate(const DiversityOptions& o) {
   auto fail = [](const std::string& what) {
     throw std::invalid_argument("diversity options: " + what);
   };
-  if (o.variations < 1) fail("variations must be >= 1");
+  // The upper limits keep a corrupt or hostile checkpoint from asking for memory or time
+  // no run could use (N^2 distances per set, lambda samples per generation).
+  if (o.variations < 1 || o.variations > kMaxDiversityVariations)
+    fail("variations must be in [1, " + std::to_string(kMaxDiversityVariations) + "]");
   if (!(o.k >= 0.0) || !std::isfinite(o.k)) fail("k must be a finite number >= 0");
-  if (o.popsize < 2) fail("popsize must be >= 2");
+  if (o.popsize < 2 || o.popsize > kMaxDiversityPopsize)
+    fail("popsize must be in [2, " + std::to_string(kMaxDiversityPopsize) + "]");
   if (!(o.sigma0 > 0.0) || !std::isfinite(o.sigma0)) fail("sigma0 must be > 0");
   if (o.max_generations < 1) fail("max_generations must be >= 1");
   if (o.window < 0) fail("window must be >= 0");
-  if (!(o.epsilon >= 0.0)) fail("epsilon must be >= 0");
+  if (!(o.epsilon >= 0.0) || !std::isfinite(o.epsilon)) fail("epsilon must be a finite number >= 0");
 }
 
 nlohmann::json to_json(const DiversityOptions& o) {
@@ -162,17 +186,17 @@ nlohmann::json to_json(const DiversityOptions& o) {
 
 DiversityOptions diversity_options_from_json(const nlohmann::json& j) {
   DiversityOptions o;
-  o.variations = j.at("variations").get<int>();
+  o.variations = integer_from_json<int>(j.at("variations"), "variations");
   o.k = j.at("k").get<double>();
   o.strategy = parse_strategy(j.at("strategy").get<std::string>(), "strategy");
   o.constraints = parse_constraint_rule(j.at("constraints").get<std::string>(), "constraints");
   o.point = parse_variation_point(j.at("point").get<std::string>(), "point");
-  o.popsize = j.at("popsize").get<int>();
+  o.popsize = integer_from_json<int>(j.at("popsize"), "popsize");
   o.sigma0 = j.at("sigma0").get<double>();
-  o.max_generations = j.at("max_generations").get<long long>();
-  o.window = j.at("window").get<int>();
+  o.max_generations = integer_from_json<long long>(j.at("max_generations"), "max_generations");
+  o.window = integer_from_json<int>(j.at("window"), "window");
   o.epsilon = j.at("epsilon").get<double>();
-  o.seed = j.at("seed").get<std::uint64_t>();
+  o.seed = integer_from_json<std::uint64_t>(j.at("seed"), "seed");
   return o;
 }
 
@@ -187,14 +211,14 @@ namespace {
 
 DiversityRecord record_from_json(const nlohmann::json& j) {
   DiversityRecord r;
-  r.generation = j.at("generation").get<long long>();
-  r.step = j.at("step").get<long long>();
-  r.variation = j.at("variation").get<int>();
+  r.generation = integer_from_json<long long>(j.at("generation"), "log.generation");
+  r.step = integer_from_json<long long>(j.at("step"), "log.step");
+  r.variation = integer_from_json<int>(j.at("variation"), "log.variation");
   r.D = j.at("D").get<double>();
   r.best_D = j.at("best_D").get<double>();
   r.constraint = vector_from_json(j.at("constraint"));
   r.dmin = vector_from_json(j.at("dmin"));
-  r.evaluations = j.at("evaluations").get<long long>();
+  r.evaluations = integer_from_json<long long>(j.at("evaluations"), "log.evaluations");
   return r;
 }
 
@@ -608,13 +632,13 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
     if (reference != problem.reference()) {
       throw UserError("checkpoint: reference: expected the problem's reference parameters");
     }
-    opt.generation_ = j.at("generation").get<long long>();
-    opt.steps_ = j.at("steps").get<long long>();
-    opt.evaluations_ = j.at("evaluations").get<long long>();
+    opt.generation_ = integer_from_json<long long>(j.at("generation"), "checkpoint: generation");
+    opt.steps_ = integer_from_json<long long>(j.at("steps"), "checkpoint: steps");
+    opt.evaluations_ = integer_from_json<long long>(j.at("evaluations"), "checkpoint: evaluations");
     opt.stop_ = parse_stop(j.at("stop").get<std::string>());
-    opt.active_ = j.at("active").get<int>();
-    opt.phase_start_ = j.at("phase_start").get<long long>();
-    opt.phase_budget_ = j.at("phase_budget").get<long long>();
+    opt.active_ = integer_from_json<int>(j.at("active"), "checkpoint: active");
+    opt.phase_start_ = integer_from_json<long long>(j.at("phase_start"), "checkpoint: phase_start");
+    opt.phase_budget_ = integer_from_json<long long>(j.at("phase_budget"), "checkpoint: phase_budget");
     for (const auto& state : j.at("cma")) opt.cmas_.push_back(Cmaes::from_json(state));
     opt.points_ = points_from_json(j.at("points"));
     opt.best_.points = points_from_json(j.at("best").at("points"));
@@ -625,8 +649,9 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
     for (const auto& path : j.at("paths")) {
       std::vector<PathPoint> p;
       for (const auto& point : path) {
-        p.push_back(PathPoint{point.at("generation").get<long long>(),
-                              point.at("step").get<long long>(), vector_from_json(point.at("x"))});
+        p.push_back(PathPoint{integer_from_json<long long>(point.at("generation"), "checkpoint: paths.generation"),
+                              integer_from_json<long long>(point.at("step"), "checkpoint: paths.step"),
+                              vector_from_json(point.at("x"))});
       }
       opt.paths_.push_back(std::move(p));
     }
@@ -645,6 +670,28 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
   for (const auto& p : opt.points_) {
     if (p.size() != problem.dim()) throw UserError("checkpoint: points: wrong dimension");
   }
+  for (const auto& p : opt.best_.points) {
+    if (p.size() != problem.dim()) throw UserError("checkpoint: best.points: wrong dimension");
+  }
+  for (const auto& path : opt.paths_) {
+    for (const PathPoint& point : path) {
+      if (point.x.size() != problem.dim()) throw UserError("checkpoint: paths: wrong dimension");
+    }
+  }
+  const int cma_dim = opt.options_.strategy == DiversityStrategy::kJoint
+                          ? opt.options_.variations * problem.dim()
+                          : problem.dim();
+  for (const Cmaes& cma : opt.cmas_) {
+    if (cma.dim() != cma_dim || cma.popsize() != opt.options_.popsize)
+      throw UserError("checkpoint: cma: expected states of dimension " + std::to_string(cma_dim) +
+                      " and popsize " + std::to_string(opt.options_.popsize));
+  }
+  if (opt.options_.strategy == DiversityStrategy::kProgressive &&
+      (opt.active_ < 1 || opt.active_ > opt.options_.variations))
+    throw UserError("checkpoint: active: expected a variation in [1, " +
+                    std::to_string(opt.options_.variations) + "]");
+  if (opt.generation_ < 0 || opt.steps_ < 0 || opt.evaluations_ < 0)
+    throw UserError("checkpoint: generation, steps, evaluations: expected counts >= 0");
 
   // Outcomes are not stored: evaluate the distinct points of the current and best sets
   // again (evaluate() is a pure function of x, so these are the same outcomes).

@@ -124,7 +124,10 @@ struct DiversityOptions {
   double epsilon = 1e-6;            // >= 0, least improvement of the best D over window
   std::uint64_t seed = 1;           // run seed; every stream derives from it
 };
-// Throws std::invalid_argument naming the first field out of range.
+// Throws std::invalid_argument naming the first field out of range (variations in
+// [1, kMaxDiversityVariations], popsize in [2, kMaxDiversityPopsize], the rest as above).
+constexpr int kMaxDiversityVariations = 1000;
+constexpr int kMaxDiversityPopsize = 100000;
 void validate(const DiversityOptions& options);
 nlohmann::json to_json(const DiversityOptions& options);
 DiversityOptions diversity_options_from_json(const nlohmann::json& j);

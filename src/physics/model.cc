@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/text_file.h"
 #include "physics/mujoco_guard.h"
 
 namespace diverse {
@@ -65,11 +66,7 @@ std::shared_ptr<const SharedModel> SharedModel::from_xml(const std::string& xml,
 }
 
 std::shared_ptr<const SharedModel> SharedModel::from_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UserError(path + ": cannot read the model file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return from_xml(text.str(), path);
+  return from_xml(read_text_file(path, "model"), path);
 }
 
 SharedModel::~SharedModel() {

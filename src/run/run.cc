@@ -10,6 +10,7 @@
 #include "eval/motion_problem.h"
 #include "io/files.h"
 #include "io/progress.h"
+#include "run/checkpoint.h"
 #include "run/outputs.h"
 #include "task/evaluate.h"
 #include "task/task.h"
@@ -21,7 +22,6 @@ namespace {
 
 constexpr const char* kRunFormat = "diverse.run";
 constexpr int kRunVersion = 1;
-constexpr const char* kCheckpointFormat = "diverse.run_checkpoint";
 
 // Everything a run needs that is rebuilt from run.json on resume.
 struct RunSetup {
@@ -61,11 +61,6 @@ RunSetup make_setup(const std::string& task_path, const std::string& metric_name
   return setup;
 }
 
-// The parameter groups a run varies, as run.json and checkpoint.json record them.
-nlohmann::json vary_json(bool vary_shape) {
-  return vary_shape ? nlohmann::json{"control", "shape"} : nlohmann::json{"control"};
-}
-
 nlohmann::json run_json(const RunSetup& setup) {
   nlohmann::json j = {{"format", kRunFormat},
                       {"version", kRunVersion},
@@ -103,11 +98,23 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
     return wall_before +
            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
+  long long saved_generation = -1;  // the generation of the last checkpoint written here
   auto write_checkpoint = [&] {
-    write_json_atomic(dir / "checkpoint.json", {{"format", kCheckpointFormat},
-                                                {"wall_seconds", elapsed()},
-                                                {"vary", vary_json(setup.vary_shape)},
-                                                {"optimizer", optimizer.checkpoint()}});
+    try {
+      write_json_atomic(dir / "checkpoint.json",
+                        run_checkpoint_json(elapsed(), setup.vary_shape, optimizer));
+    } catch (const UserError& e) {
+      // A full disk or a vanished directory: the previous checkpoint is untouched (the
+      // write went to a temporary), so the run can go on from it once the cause is gone.
+      throw UserError(std::string(e.what()) + "; " +
+                      (saved_generation >= 0 || fs::exists(dir / "checkpoint.json")
+                           ? "the last checkpoint" +
+                                 (saved_generation >= 0 ? " (generation " + std::to_string(saved_generation) + ")"
+                                                        : std::string()) +
+                                 " is intact: `diverse resume " + dir.string() + "` continues from it"
+                           : std::string("no checkpoint was written")));
+    }
+    saved_generation = optimizer.generation();
   };
 
   std::FILE* sink = quiet ? nullptr : stderr;
@@ -193,8 +200,19 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
     throw UserError(dir.string() + ": not a run directory (no run.json; start one with `diverse run`)");
   const nlohmann::json run = read_json(dir / "run.json");
   const std::string where = (dir / "run.json").string();
-  if (!run.is_object() || run.value("format", "") != kRunFormat)
+  if (!run.is_object() || !run.contains("format") || run["format"] != kRunFormat)
     throw UserError(where + ": format: expected \"" + kRunFormat + "\"");
+  DiversityOptions options;
+  try {
+    options = diversity_options_from_json(run.at("options"));
+    validate(options);
+  } catch (const UserError& e) {
+    throw UserError(where + ": options." + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UserError(where + ": options: " + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(where + ": options: expected the settings `diverse run` writes (" + e.what() + ")");
+  }
   RunSetup setup;
   try {
     const std::string task_file = run.at("task_file").get<std::string>();
@@ -205,37 +223,26 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
       throw UserError(task_file + ": changed since the run started; a resumed run must use the same task");
     setup = make_setup(task_file, run.at("metric").get<std::string>(),
                        run.value("shape_weight", kDefaultShapeWeight), read_vary_shape(run, where),
-                       diversity_options_from_json(run.at("options")));
+                       options);
   } catch (const nlohmann::json::exception& e) {
     throw UserError(where + ": expected the settings `diverse run` writes (" + e.what() + ")");
   }
 
-  if (!fs::exists(dir / "checkpoint.json"))
-    throw UserError(dir.string() + ": no checkpoint.json to resume from");
-  const nlohmann::json checkpoint = read_json(dir / "checkpoint.json");
-  const std::string cwhere = (dir / "checkpoint.json").string();
-  if (!checkpoint.is_object() || checkpoint.value("format", "") != kCheckpointFormat ||
-      !checkpoint.contains("optimizer"))
-    throw UserError(cwhere + ": format: expected a checkpoint written by `diverse run`");
-  if (checkpoint.contains("vary") && checkpoint["vary"] != vary_json(setup.vary_shape))
-    throw UserError(cwhere + ": vary: " + checkpoint["vary"].dump() + " does not match run.json's " +
-                    vary_json(setup.vary_shape).dump());
-
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape);
+  // What a kill in the middle of a write left (the files themselves are whole: io/files.h).
+  for (const char* sub : {"", "motions", "model", "paths"}) remove_stale_temporaries(dir / sub);
+  double wall_before = 0.0;
   std::unique_ptr<DiversityOptimizer> optimizer;
-  try {
-    optimizer = std::make_unique<DiversityOptimizer>(
-        DiversityOptimizer::from_checkpoint(problem, checkpoint.at("optimizer"), pool));
-  } catch (const UserError& e) {
-    throw UserError(cwhere + ": " + e.what());
-  } catch (const nlohmann::json::exception& e) {
-    throw UserError(cwhere + ": corrupt checkpoint (" + std::string(e.what()) + ")");
-  } catch (const std::logic_error& e) {
-    throw UserError(cwhere + ": does not reproduce on this machine (" + std::string(e.what()) + ")");
+  if (fs::exists(dir / "checkpoint.json")) {
+    const nlohmann::json state = read_run_checkpoint(dir / "checkpoint.json", setup.vary_shape, &wall_before);
+    optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json");
+  } else {
+    // Stopped between writing run.json and its first checkpoint: run.json holds every
+    // setting, so the run starts again from generation 0 (the same run, by determinism).
+    optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool);
   }
-  const double wall_before = checkpoint.value("wall_seconds", 0.0);
   drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render);
 }
 

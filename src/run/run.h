@@ -51,7 +51,8 @@ struct RunRequest {
 void start_run(const RunRequest& request);
 
 // Continues the run in `dir` from its checkpoint (threads: 0 = one per core). A run that
-// already finished only has its outputs written again. Throws UserError if `dir` is not
+// already finished only has its outputs written again; one stopped before its first
+// checkpoint starts again from run.json's settings. Throws UserError if `dir` is not
 // a run directory, its checkpoint is corrupt, or its task file changed.
 void resume_run(const std::filesystem::path& dir, int threads, bool quiet = false,
                 double checkpoint_seconds = 5.0, bool render = true);

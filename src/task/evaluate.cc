@@ -7,6 +7,8 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "core/text_file.h"
+#include "task/scene_check.h"
 
 namespace diverse {
 namespace {
@@ -165,6 +167,7 @@ class JumpHooks : public StepHooks {
 TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
   model_ = SharedModel::from_xml(scene_xml(task_), task_.model);
   body_ = std::make_unique<Character>(bind_character(task_.character_spec, model_->get(), task_.model));
+  check_scene(task_, model_->get(), *body_);
   task_.controller_type->check(*body_, task_.file);
   specs_ = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   if (task_.constraints.clearance) {
@@ -183,12 +186,11 @@ namespace {
 // The named values of a parameter file: {"parameters": {...}} (a motion or M0 file) or
 // the object itself.
 nlohmann::json read_parameter_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw UserError(path + ": cannot read the parameter file");
+  const std::string text = read_text_file(path, "parameter");
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {  // parse_error, or out_of_range for 1e999
     throw UserError(path + ": expected valid JSON (" + std::string(e.what()) + ")");
   }
   if (j.is_object() && j.contains("parameters")) return j["parameters"];

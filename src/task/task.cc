@@ -8,6 +8,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "core/text_file.h"
 #include "core/toml_reader.h"
 
 namespace diverse {
@@ -47,7 +48,12 @@ void read_objects(const TomlReader& r, const toml::node* node, Task& task) {
     o.only({"name", "kind", "x_min", "x_max", "height"});
     SceneObject obj;
     obj.name = o.string("name");
-    if (obj.name.empty()) o.fail("name", "expected a non-empty string");
+    // The name goes into the scene's MJCF as an attribute: letters, digits, '_', '-' and
+    // '.' only, so that no name can break out of it.
+    if (obj.name.empty() || obj.name.size() > 64 ||
+        obj.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
+            std::string::npos)
+      o.fail("name", "expected 1 to 64 letters, digits, '_', '-' or '.', got \"" + obj.name + "\"");
     for (const SceneObject& other : task.objects) {
       if (other.name == obj.name) o.fail("name", "expected a unique name, \"" + obj.name + "\" repeats");
     }
@@ -134,6 +140,8 @@ void read_simulation(const TomlReader& r, Task& task) {
   s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
   s.clearance_range = r.number("clearance_range", 0.01, 2, s.clearance_range);
   s.timestep = r.number("timestep", 0, 0.01, s.timestep);
+  if (s.timestep != 0 && s.timestep < 1e-5)
+    r.fail("timestep", "expected 0 (the model's) or a number in [1e-05, 0.01], got " + num(s.timestep));
 }
 
 void read_seed(const TomlReader& r, Task& task) {
@@ -180,15 +188,7 @@ const SceneObject* Task::find_object(const std::string& object_name) const {
 }
 
 Task load_task(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw UserError(path + ": cannot read the task file");
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    std::string what(e.description());
-    throw UserError(path + ": line " + std::to_string(e.source().begin.line) +
-                    ": expected valid TOML (" + what + ")");
-  }
+  const toml::table root = parse_toml_file(path, "task");
   Task task;
   task.file = path;
   TomlReader r(path, root, "");
@@ -226,11 +226,7 @@ std::string resolve_task_path(const std::string& name_or_path) {
 }
 
 std::string scene_xml(const Task& task) {
-  std::ifstream in(task.model, std::ios::binary);
-  if (!in) throw UserError(task.model + ": cannot read the model file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string xml = buffer.str();
+  std::string xml = read_text_file(task.model, "model");
   std::ostringstream geoms;
   geoms.precision(17);
   for (const SceneObject& o : task.objects) {

@@ -1,6 +1,8 @@
 #include "io/files.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+#include <fstream>
 
 #include <cmath>
 #include <limits>
@@ -55,7 +57,7 @@ TEST(ReadFile, MissingFileIsAOneLineUserError) {
     read_file("/nonexistent/dir/x.json");
     FAIL();
   } catch (const UserError& e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/dir/x.json: cannot read (no such file)");
+    EXPECT_STREQ(e.what(), "/nonexistent/dir/x.json: cannot read (No such file or directory)");
   }
 }
 
@@ -71,6 +73,49 @@ TEST(ReadJson, MalformedJsonNamesTheFile) {
         << what;
     EXPECT_EQ(what.find('\n'), std::string::npos);
   }
+}
+
+TEST(ReadJson, ANumberTooLargeForADoubleIsAnErrorNotACrash) {
+  const fs::path dir = scratch("huge");
+  write_file_atomic(dir / "huge.json", "{\"a\": 1e999}");
+  try {
+    read_json(dir / "huge.json");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind((dir / "huge.json").string() + ": not valid JSON (", 0), 0u) << e.what();
+  }
+}
+
+TEST(ReadFile, DirectoriesAndDevicesAreOneLineErrors) {
+  const fs::path dir = scratch("dir");
+  fs::create_directories(dir);
+  fs::create_directories(dir / "sub");
+  try {
+    read_file(dir / "sub");
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "sub").string() + ": cannot read (it is a directory)");
+  }
+  try {
+    read_file("/dev/zero");  // would never end
+    FAIL();
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(), "/dev/zero: cannot read (not a regular file)");
+  }
+}
+
+TEST(RemoveStaleTemporaries, RemovesOnlyThoseOfProcessesThatAreGone) {
+  const fs::path dir = scratch("stale");
+  fs::create_directories(dir);
+  // PID 2^22 + 1 is above Linux's largest pid_max: no such process.
+  const fs::path dead = dir / "checkpoint.json.tmp.4194305.0";
+  const fs::path alive = dir / ("checkpoint.json.tmp." + std::to_string(::getpid()) + ".3");
+  const fs::path other = dir / "notes.tmp.txt";
+  for (const fs::path& p : {dead, alive, other}) std::ofstream(p) << "x";
+  EXPECT_EQ(remove_stale_temporaries(dir), 1);
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(alive));
+  EXPECT_TRUE(fs::exists(other));
 }
 
 TEST(EnsureWritableDirectory, RefusesAPathThatIsAFile) {

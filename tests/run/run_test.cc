@@ -95,9 +95,9 @@ TEST(RunErrors, OneLineMessagesAndNonZeroExit) {
   };
   const Case cases[] = {
       {"run no_such_task --out " + out.string(), "no_such_task"},
-      {"run " + kTask + " --n -1 --out " + out.string(), "--n: expected an integer >= 1"},
-      {"run " + kTask + " --k -2 --out " + out.string(), "--k: expected a number >= 0"},
-      {"run " + kTask + " --generations 0 --out " + out.string(), "--generations: expected an integer >= 1"},
+      {"run " + kTask + " --n -1 --out " + out.string(), "--n: expected an integer in [1, 100], got '-1'"},
+      {"run " + kTask + " --k -2 --out " + out.string(), "--k: expected a number in [0, 1000000000], got '-2'"},
+      {"run " + kTask + " --generations 0 --out " + out.string(), "--generations: expected an integer in [1, 1000000], got '0'"},
       {"run " + kTask + " --strategy sideways --out " + out.string(), "sideways"},
       {"run " + kTask + " --constraints soft --out " + out.string(),
        "--constraints: expected one of dominant, penalty, got 'soft'"},

@@ -239,7 +239,7 @@ TEST(ShapeRunErrors, OneLineMessagesAndNonZeroExit) {
        "--metric: the md+shape metric needs the shape parameters (--vary shape)"},
       {"run " + kTask + " --vary legs --out " + out.string(), "--vary: expected control or shape, got 'legs'"},
       {"run " + kTask + " --vary shape --metric md+shape --shape-weight -1 --out " + out.string(),
-       "--shape-weight: expected a number > 0"},
+       "--shape-weight: expected a number in (0, 1000000000], got '-1'"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

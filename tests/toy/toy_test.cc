@@ -270,11 +270,11 @@ TEST(ToyCli, BadArgumentsGiveOneLineErrors) {
   const fs::path file = temp_dir("file");
   std::ofstream(file.string()) << "not a directory";
   const std::vector<Case> cases = {
-      {"toy --k -1" + out, "diverse: error: --k: expected a number >= 0, got -1\n"},
-      {"toy --n 0" + out, "diverse: error: --n: expected an integer >= 1, got 0\n"},
-      {"toy --threads 0" + out, "diverse: error: --threads: expected an integer >= 1, got 0\n"},
+      {"toy --k -1" + out, "diverse: error: --k: expected a number in [0, 1000000000], got '-1'\n"},
+      {"toy --n 0" + out, "diverse: error: --n: expected an integer in [1, 100], got '0'\n"},
+      {"toy --threads 0" + out, "diverse: error: --threads: expected an integer in [1, 256], got '0'\n"},
       {"toy --generations 0" + out,
-       "diverse: error: --generations: expected an integer >= 1, got 0\n"},
+       "diverse: error: --generations: expected an integer in [1, 1000000], got '0'\n"},
       {"toy --strategy greedy" + out,
        "diverse: error: --strategy: expected one of round-robin, progressive, joint, got "
        "'greedy'\n"},

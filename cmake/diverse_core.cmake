@@ -1,0 +1,49 @@
+# The dependencies and the core library (every stage of the pipeline, src/), shared by
+# the main build and the libFuzzer build (fuzz/CMakeLists.txt). Expects DIVERSE_ROOT (the
+# repository root) and DIVERSE_VERSION_STRING.
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+# Debian's mujocoConfig.cmake names include directories that no package installs
+# (libqhull_r), so the library is located directly instead of through its config.
+find_path(MUJOCO_INCLUDE_DIR mujoco/mujoco.h REQUIRED)
+find_library(MUJOCO_LIBRARY mujoco REQUIRED)
+add_library(diverse_mujoco INTERFACE)
+target_include_directories(diverse_mujoco SYSTEM INTERFACE ${MUJOCO_INCLUDE_DIR})
+target_link_libraries(diverse_mujoco INTERFACE ${MUJOCO_LIBRARY})
+find_package(tomlplusplus REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(Threads REQUIRED)
+find_package(PNG REQUIRED)
+# Offscreen rendering (src/render/) uses Mesa's OSMesa; see docs/rendering.md.
+find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
+find_library(OSMESA_LIBRARY OSMesa REQUIRED)
+
+set(DIVERSE_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  # GCC 12 reports std::string concatenation as overlapping memcpy (GCC bug 105329).
+  list(APPEND DIVERSE_WARNINGS -Wno-restrict)
+endif()
+
+# The core library: every stage of the pipeline, one folder each under src/.
+# A build may name the folders it needs (DIVERSE_CORE_FOLDERS, e.g. the fuzz build) and extra
+# single files (DIVERSE_CORE_EXTRA); by default the library holds every folder.
+if(DEFINED DIVERSE_CORE_FOLDERS)
+  set(DIVERSE_SOURCES ${DIVERSE_CORE_EXTRA})
+  foreach(folder ${DIVERSE_CORE_FOLDERS})
+    file(GLOB folder_sources CONFIGURE_DEPENDS ${DIVERSE_ROOT}/src/${folder}/*.cc)
+    list(APPEND DIVERSE_SOURCES ${folder_sources})
+  endforeach()
+else()
+  file(GLOB_RECURSE DIVERSE_SOURCES CONFIGURE_DEPENDS ${DIVERSE_ROOT}/src/*.cc)
+endif()
+add_library(diverse_core STATIC ${DIVERSE_SOURCES})
+target_include_directories(diverse_core PUBLIC ${DIVERSE_ROOT}/src)
+target_compile_options(diverse_core PRIVATE ${DIVERSE_WARNINGS})
+target_compile_definitions(diverse_core PUBLIC
+  DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}"
+  DIVERSE_VERSION="${DIVERSE_VERSION_STRING}")
+target_link_libraries(diverse_core PUBLIC
+  Eigen3::Eigen diverse_mujoco tomlplusplus::tomlplusplus
+  nlohmann_json::nlohmann_json Threads::Threads PNG::PNG ${OSMESA_LIBRARY})
+target_include_directories(diverse_core SYSTEM PRIVATE ${OSMESA_INCLUDE_DIR})
+
