@@ -191,10 +191,10 @@ void expect_walks(const Expect& e, double timestep) {
 }
 
 TEST(WalkController, HumanWalksThirtySteps) {
-  expect_walks({"human3d", "silly_walk_start.json", 0.4, 0.9}, 0.002);
+  expect_walks({"human3d", "silly_walk_start.json", 0.5, 1.5}, 0.002);
 }
 TEST(WalkController, HumanWalksAtHalfTheTimestep) {
-  expect_walks({"human3d", "silly_walk_start.json", 0.4, 0.9}, 0.001);
+  expect_walks({"human3d", "silly_walk_start.json", 0.5, 1.5}, 0.001);
 }
 TEST(WalkController, RobotWalksThirtySteps) {
   expect_walks({"robot3d", "robot_silly_walk_start.json", 0.9, 1.5}, 0.002);
