@@ -292,6 +292,15 @@ TEST_F(RunMediaTest, CommandsWriteTheirFiles) {
     EXPECT_EQ(file.joints.size(), 17u);
     EXPECT_EQ(file.frame_count(), static_cast<int>(run.motions[static_cast<std::size_t>(i)].sample(60).size()));
   }
+
+  const Result gltf = run_cli("export " + dir.string() + " --gltf");
+  ASSERT_EQ(gltf.status, 0) << gltf.output;
+  for (const char* name : {"m0.glb", "m1.glb", "all.glb"}) {
+    const std::string bytes = read_file(dir / "export" / name);
+    ASSERT_GT(bytes.size(), 12u) << name;
+    EXPECT_EQ(bytes.substr(0, 4), "glTF") << name;  // the binary container's magic
+  }
+  EXPECT_NE(gltf.output.find("all.glb  (2 motions side by side"), std::string::npos) << gltf.output;
 }
 
 TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
@@ -305,7 +314,7 @@ TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
   const fs::path unfinished = copy("unfinished");
   fs::remove(unfinished / "summary.json");
 
-  for (const std::string command : {"render", "gallery", "export --bvh"}) {
+  for (const std::string command : {"render", "gallery", "export --bvh", "export --gltf"}) {
     SCOPED_TRACE(command);
     Result r = run_cli(command + " " + empty.string());
     EXPECT_EQ(r.status, 2);
@@ -336,7 +345,7 @@ TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
   EXPECT_EQ(r.output, "diverse: error: --fps: expected 30 or 60, got 45\n");
   r = run_cli("export " + dir_.string());
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output, "diverse: error: export: choose a format: --bvh\n");
+  EXPECT_EQ(r.output, "diverse: error: export: choose a format: --bvh, --gltf or both\n");
 
   // The page template missing, with no node to build it.
   r = run_cli("gallery " + dir_.string(), "PATH=/nonexistent DIVERSE_GALLERY_TEMPLATE=/nonexistent/t.html");
