@@ -5,12 +5,14 @@
 
 #include "control/controller.h"
 #include "control/jump_controller.h"
+#include "control/walk_controller.h"
 
 namespace diverse {
 
 std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   std::vector<std::unique_ptr<ControllerType>> types;
   types.push_back(std::make_unique<JumpControllerType>());
+  types.push_back(std::make_unique<WalkControllerType>());
   return types;
 }
 
