@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace diverse {
 
@@ -108,13 +109,15 @@ FilmColumns motion_film_columns(const PhaseTimes& p, const StepRecorder& record)
     add(p.names[static_cast<std::size_t>(first)], p.at(first + length));
     return columns;
   }
-  bool any = false;
-  for (std::size_t k = 0; k < p.names.size() && k < p.begin.size(); ++k) {
-    if (p.begin[k] < 0) continue;
-    add(p.names[k], p.begin[k]);
-    any = true;
-  }
-  if (any) {
+  // In the order they began (a controller that keeps each phase's latest begin, such as a
+  // walk's, then shows the last time through each).
+  std::vector<std::pair<double, std::size_t>> reached;
+  for (std::size_t k = 0; k < p.names.size() && k < p.begin.size(); ++k)
+    if (p.begin[k] >= 0) reached.emplace_back(p.begin[k], k);
+  std::stable_sort(reached.begin(), reached.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [begin, k] : reached) add(p.names[k], begin);
+  if (!reached.empty()) {
     add("end", end);
     return columns;
   }

@@ -27,7 +27,9 @@ FilmColumns jump_film_columns(const Evaluation& evaluation, const StepRecorder& 
 //     last complete stride, from the cycle's first state, each of its phases at its begin
 //     and half-way through it, then the next stride's begin ("mid <phase>" names the
 //     half-way columns);
-//   - other phases: each phase reached at its begin, then the end;
+//   - other phases: each phase reached at its begin, in the order they began, then the end
+//     (a controller that keeps only each phase's latest begin, as a walk's does, shows the
+//     last time through each);
 //   - no phases: kEvenColumns moments evenly spaced from the start to the end.
 constexpr int kEvenColumns = 6;
 FilmColumns motion_film_columns(const PhaseTimes& phases, const StepRecorder& record);

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # End-to-end test of `diverse gallery` and `diverse export --bvh --gltf` in headless
-# Chromium: makes a short real run (the planar human's high jump) and a run of 3D motions
-# (the 3D human pushed three ways under stance control, tests/support/stance_run.h), their
-# gallery pages, BVH and glTF files, then runs web/test/gallery.e2e.mjs on each (no
-# network: the page must work from disk).
+# Chromium: makes a short real run (the planar human's high jump), a run of 3D motions
+# (the 3D human pushed three ways under stance control, tests/support/stance_run.h) and a
+# 3D walk that the views follow, their gallery pages, BVH and glTF files, then runs
+# web/test/gallery.e2e.mjs on each (no network: the page must work from disk).
 #
 #   gallery_e2e.sh DIVERSE_BINARY SOURCE_DIR MAKE_STANCE_RUN_BINARY
 #
@@ -30,7 +30,7 @@ fi
 
 if [ -n "${E2E_KEEP:-}" ]; then
   work="$E2E_KEEP"
-  rm -rf "$work/run" "$work/run3d"
+  rm -rf "$work/run" "$work/run3d" "$work/walk"
   mkdir -p "$work"
 else
   work="$(mktemp -d)"
@@ -48,3 +48,9 @@ CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/run"
 "$diverse" gallery "$work/run3d" --no-paths
 "$diverse" export "$work/run3d" --bvh --gltf
 CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/run3d"
+
+# A walker: 12 steps of the 3D human's SIMBICON walk (about 6 m), which the views follow.
+"$make_stance_run" "$work/walk" human3d walk 12 silly_walk_start.json
+"$diverse" gallery "$work/walk" --no-paths
+"$diverse" export "$work/walk" --bvh --gltf
+CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/walk"

@@ -180,6 +180,15 @@ TEST(FilmColumns, OneStrideOfACyclicMotion) {
   EXPECT_EQ(o.names, (std::vector<std::string>{"start", "lean", "settle", "end"}));
   EXPECT_NEAR(o.frames[3][0], 3.0, 1e-9);
 
+  // A walk's controller keeps each state's latest begin: the last time through each state,
+  // in time order.
+  PhaseTimes latest;
+  latest.names = {"left_lift", "left_strike", "right_lift", "right_strike"};
+  latest.begin = {2.0, 2.3, 1.4, 1.7};
+  const FilmColumns l = motion_film_columns(latest, r);
+  EXPECT_EQ(l.names, (std::vector<std::string>{"right_lift", "right_strike", "left_lift", "left_strike", "end"}));
+  EXPECT_NEAR(l.frames[0][0], 1.4, 1e-9);
+
   // No phases: evenly spaced moments.
   const FilmColumns e = motion_film_columns(PhaseTimes{}, r);
   ASSERT_EQ(e.names.size(), static_cast<std::size_t>(kEvenColumns));
@@ -196,6 +205,34 @@ TEST(FilmColumns, OneStrideOfACyclicMotion) {
   const FilmColumns j = motion_film_columns(jump, r);
   EXPECT_EQ(j.names, (std::vector<std::string>{"crouch", "extend", "take-off", "rising", "peak", "falling",
                                                 "touch-down", "end"}));
+}
+
+// A real walk (the 3D human under SIMBICON control, 12 steps, about 6 m): the film strip
+// follows it, one stride from its left lift, the character large in every tile.
+TEST(Walk3d, FilmStripFollowsOneStride) {
+  const fs::path dir = out_dir() / "walk";
+  test_support::write_walk_run(dir, "human3d", {"silly_walk_start.json"}, 12);
+  const RunView run = load_run_view(dir);
+  ASSERT_EQ(run.motions.size(), 1u);
+  const RunMotion& walk = run.motions[0];
+  const auto frames = walk.sample(10);
+  const ViewPlan plan = plan_view(std::vector<PosedModel>{{walk.model->get(), frames}});
+  EXPECT_TRUE(plan.three_quarter);
+  EXPECT_TRUE(plan.follow) << "the walk travels "
+                           << follow_anchor(walk.model->get(), frames.back())[0] - follow_anchor(walk.model->get(), frames.front())[0] << " m";
+  EXPECT_NEAR(plan.heading, 0.0, 20.0) << "it walks along +x";
+  const FilmColumns columns = motion_film_columns(walk.phases, walk.record);
+  ASSERT_EQ(columns.names.size(), 9u);
+  EXPECT_EQ(columns.names[0], "left_lift");
+  EXPECT_EQ(columns.names[1], "mid left_lift");
+  EXPECT_EQ(columns.names[8], "left_lift");
+  write_run_film_strip(run, dir / "filmstrip.png");
+  const Image strip = read_png((dir / "filmstrip.png").string());
+  const int label_w = text_width("M0", FontSize::kLarge) + 8;
+  const int title_h = text_height(FontSize::kMedium) + 8;
+  const int x0 = 12 + label_w, y0 = 12 + title_h + text_height(FontSize::kLarge) + 4;
+  for (int c = 0; c < 9; ++c)
+    EXPECT_GT(character_height_fraction(strip, x0 + c * (240 + 6), y0, 240, 240), 0.5) << "tile " << c;
 }
 
 // A run of 3D motions (the 3D human pushed three ways): its film strip is drawn

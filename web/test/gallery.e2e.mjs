@@ -171,15 +171,17 @@ try {
   const three = Boolean(data.view && data.view.three_quarter);
   check((await page.textContent('#reset-view')).trim() === (three ? 'Three-quarter view' : 'Side view'),
     `the view button names the ${three ? 'three-quarter' : 'side'} view`);
+  const following = await page.locator('#follow').isChecked();
+  check(following === Boolean(data.view && data.view.follow), `"follow" starts ${following ? 'on (the characters travel far)' : 'off'}`);
   if (three) {
     await page.locator('#time').fill('700');
     await settle();
     await snapshot();
-    await page.locator('#follow').check();
+    await page.locator('#follow').setChecked(!following);
     await settle();
-    const followed = await snapshot();
-    check(followed.changed > 500, 'turning "follow" on moves the views', `${followed.changed} pixels changed`);
-    await page.locator('#follow').uncheck();
+    const switched = await snapshot();
+    check(switched.changed > 500, 'switching "follow" moves the views', `${switched.changed} pixels changed`);
+    await page.locator('#follow').setChecked(following);
   }
 
   // ---------------------------------------------------------------- the plots panel
