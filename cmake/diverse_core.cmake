@@ -9,11 +9,14 @@ find_library(MUJOCO_LIBRARY mujoco REQUIRED)
 add_library(diverse_mujoco INTERFACE)
 target_include_directories(diverse_mujoco SYSTEM INTERFACE ${MUJOCO_INCLUDE_DIR})
 target_link_libraries(diverse_mujoco INTERFACE ${MUJOCO_LIBRARY})
+set_target_properties(diverse_mujoco PROPERTIES EXPORT_NAME mujoco)
 find_package(tomlplusplus REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(Threads REQUIRED)
 find_package(PNG REQUIRED)
+# glTF export (src/io/gltf.h): Debian's tinygltf, shipped as a shared library.
+find_package(TinyGLTF REQUIRED)
 # Offscreen rendering (src/render/) uses Mesa's OSMesa; see docs/rendering.md.
 find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
 find_library(OSMESA_LIBRARY OSMesa REQUIRED)
@@ -37,13 +40,17 @@ else()
   file(GLOB_RECURSE DIVERSE_SOURCES CONFIGURE_DEPENDS ${DIVERSE_ROOT}/src/*.cc)
 endif()
 add_library(diverse_core STATIC ${DIVERSE_SOURCES})
-target_include_directories(diverse_core PUBLIC ${DIVERSE_ROOT}/src)
+add_library(diverse::core ALIAS diverse_core)
+set_target_properties(diverse_core PROPERTIES EXPORT_NAME core POSITION_INDEPENDENT_CODE ON)
+# Installed, the headers keep their folders under include/diverse (#include "optimize/cmaes.h").
+target_include_directories(diverse_core PUBLIC
+  $<BUILD_INTERFACE:${DIVERSE_ROOT}/src> $<INSTALL_INTERFACE:include/diverse>)
 target_compile_options(diverse_core PRIVATE ${DIVERSE_WARNINGS})
-target_compile_definitions(diverse_core PUBLIC
-  DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}"
-  DIVERSE_VERSION="${DIVERSE_VERSION_STRING}")
+target_compile_definitions(diverse_core
+  PUBLIC $<BUILD_INTERFACE:DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}">
+  PRIVATE DIVERSE_VERSION="${DIVERSE_VERSION_STRING}")
 target_link_libraries(diverse_core PUBLIC
   Eigen3::Eigen diverse_mujoco tomlplusplus::tomlplusplus
   nlohmann_json::nlohmann_json Threads::Threads PNG::PNG ${OSMESA_LIBRARY})
 target_include_directories(diverse_core SYSTEM PRIVATE ${OSMESA_INCLUDE_DIR})
-
+target_link_libraries(diverse_core PRIVATE TinyGLTF::TinyGLTF)
