@@ -6,6 +6,7 @@
 namespace diverse {
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
+  if (task.walk.enabled) return walk_constraints(task, motion);
   const TaskConstraints& c = task.constraints;
   ConstraintReport report;
   auto add = [&](const char* name, double violation, double penalty) {
@@ -63,6 +64,7 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
 }
 
 double constraint_margin(const Task& task, const MotionSummary& motion) {
+  if (task.walk.enabled) return walk_margin(task, motion);
   const TaskConstraints& c = task.constraints;
   double margin = 1.0;  // m; no constraint is looser than this counts
   for (const double x : {motion.touchdown_feet_x, motion.feet_x}) {

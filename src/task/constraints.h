@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "task/task.h"
+#include "task/walk_task.h"
 
 namespace diverse {
 
@@ -40,6 +41,7 @@ struct MotionSummary {
   double rotation_flight = 0; // rad, root pitch at landing minus at take-off
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double end_time = 0;        // s
+  WalkSummary walk;           // a walk task's steps (task/walk_task.h)
 };
 
 struct ConstraintTerm {
