@@ -1,7 +1,9 @@
 // A disk that fills up, for tests (LD_PRELOAD): writes to files under the directory
 // DIVERSE_FULL_DISK_DIR share a budget of DIVERSE_FULL_DISK_BYTES bytes; once it is
 // spent, a write is cut short and the next one fails with ENOSPC, as on a full file
-// system. Writes elsewhere (stdout, other directories) are untouched.
+// system. With DIVERSE_FULL_DISK_STALL=1 the write that meets the end of the budget
+// stops for good instead (a writer frozen mid-write, for a test to kill at that moment).
+// Writes elsewhere (stdout, other directories) are untouched.
 #include <dlfcn.h>
 #include <errno.h>
 #include <stdio.h>
@@ -29,6 +31,10 @@ size_t allowed(int fd, size_t n) {
   if (strncmp(path, dir, strlen(dir)) != 0) return n;
   const long long budget = atoll(bytes);
   const long long before = spent.fetch_add(static_cast<long long>(n));
+  const char* stall = getenv("DIVERSE_FULL_DISK_STALL");
+  if (stall != nullptr && stall[0] == '1' && before + static_cast<long long>(n) > budget) {
+    for (;;) pause();
+  }
   if (before >= budget) return 0;
   return static_cast<size_t>(before + static_cast<long long>(n) <= budget ? static_cast<long long>(n)
                                                                             : budget - before);
