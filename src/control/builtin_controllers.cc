@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "control/controller.h"
+#include "control/jump3d_controller.h"
 #include "control/jump_controller.h"
 
 namespace diverse {
@@ -11,6 +12,7 @@ namespace diverse {
 std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   std::vector<std::unique_ptr<ControllerType>> types;
   types.push_back(std::make_unique<JumpControllerType>());
+  types.push_back(std::make_unique<Jump3dControllerType>());
   return types;
 }
 

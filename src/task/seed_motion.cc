@@ -300,7 +300,8 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
 }
 
 double landing_shift(const MotionSummary& a, const MotionSummary& b) {
-  return std::max(std::fabs(a.touchdown_feet_x - b.touchdown_feet_x), std::fabs(a.feet_x - b.feet_x));
+  return std::max(std::hypot(a.touchdown_feet_x - b.touchdown_feet_x, a.touchdown_feet_y - b.touchdown_feet_y),
+                  std::hypot(a.feet_x - b.feet_x, a.feet_y - b.feet_y));
 }
 
 std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,
