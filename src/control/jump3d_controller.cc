@@ -111,6 +111,33 @@ double clamp_to_range(const CharacterJoint& j, double q) {
 
 }  // namespace
 
+HipAngles hip_angles_for(const Vec3& leg, const Vec3& pitch_axis, const Vec3& roll_axis, bool has_roll,
+                         const Vec3& direction) {
+  HipAngles out;
+  const Vec3& u = leg;
+  const Vec3& w = direction;
+  const Vec3& ap = pitch_axis;
+  // Roll first (the pitch, applied after it, keeps every component along its own axis):
+  // make u's component along the pitch axis equal w's. With a the roll axis (orthogonal to
+  // the pitch axis), (R(a, r) u) . ap = A cos r + B sin r, A = u . ap, B = (a x u) . ap.
+  if (has_roll) {
+    const Vec3& ar = roll_axis;
+    const double A = dot(u, ap), B = dot(cross(ar, u), ap), c = dot(w, ap);
+    const double R = std::hypot(A, B);
+    if (R > 1e-12) {
+      const double base = std::atan2(B, A), spread = std::acos(std::clamp(c / R, -1.0, 1.0));
+      const double r1 = std::remainder(base + spread, 2 * M_PI), r2 = std::remainder(base - spread, 2 * M_PI);
+      out.roll = std::fabs(r1) < std::fabs(r2) ? r1 : r2;
+    }
+  }
+  const Vec3 u1 = has_roll ? turn(roll_axis, out.roll, u) : u;
+  // Then the pitch: the turn about the pitch axis from u1 to w, in the plane normal to it.
+  const Vec3 a_perp = sub(u1, scale(ap, dot(u1, ap)));
+  const Vec3 b_perp = sub(w, scale(ap, dot(w, ap)));
+  out.pitch = std::atan2(dot(ap, cross(a_perp, b_perp)), dot(a_perp, b_perp));
+  return out;
+}
+
 std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_height(double height) const {
   auto c = std::make_shared<Jump3dControllerConfig>(*this);
   c->landing_height_m = height;
@@ -233,7 +260,6 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
     if (hip_roll >= 0 && body.groups[static_cast<size_t>(hip_roll)].joints.size() == 2) {
       leg.hip_roll = body.groups[static_cast<size_t>(hip_roll)].joints[static_cast<size_t>(s)];
     }
-    leg.knee = body.groups[static_cast<size_t>(knee_)].joints[static_cast<size_t>(s)];
   }
 }
 
@@ -277,10 +303,8 @@ void Jump3dController::reset(const mjModel* m, const mjData* d) {
   for (int s = 0; s < 2; ++s) {
     LegGeometry& leg = legs_[static_cast<size_t>(s)];
     const CharacterJoint& hip = body_.joints[static_cast<size_t>(leg.hip_pitch)];
-    const CharacterJoint& knee = body_.joints[static_cast<size_t>(leg.knee)];
     const int foot_joint = body_.groups[static_cast<size_t>(foot_group)].joints[static_cast<size_t>(s)];
     const CharacterJoint& foot = body_.joints[static_cast<size_t>(foot_joint)];
-    leg.knee0 = m->qpos0[knee.qpos];
     leg.pitch0 = m->qpos0[hip.qpos];
     leg.pitch_axis = in_frame(root0_inv_, hip.axis0);
     if (leg.hip_roll >= 0) {
@@ -288,9 +312,26 @@ void Jump3dController::reset(const mjModel* m, const mjData* d) {
       leg.roll0 = m->qpos0[roll.qpos];
       leg.roll_axis = in_frame(root0_inv_, roll.axis0);
     }
-    leg.knee_axis = in_frame(root0_inv_, knee.axis0);
-    leg.thigh = in_frame(root0_inv_, sub(knee.anchor0, hip.anchor0));
-    leg.shin = in_frame(root0_inv_, sub(foot.anchor0, knee.anchor0));
+    // The joints strictly between the hip's body and the foot's, top down (chain() runs
+    // from the joint's body up to the root).
+    const std::vector<int>& chain = body_.chain(foot_joint);
+    leg.middle.clear();
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(*it)];
+      if (j.body != hip.body && j.body != foot.body) leg.middle.push_back(*it);
+    }
+    leg.middle0.clear();
+    leg.axes.clear();
+    leg.segments.clear();
+    Vec3 from = hip.anchor0;
+    for (int k : leg.middle) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      leg.middle0.push_back(m->qpos0[j.qpos]);
+      leg.axes.push_back(in_frame(root0_inv_, j.axis0));
+      leg.segments.push_back(in_frame(root0_inv_, sub(j.anchor0, from)));
+      from = j.anchor0;
+    }
+    leg.segments.push_back(in_frame(root0_inv_, sub(foot.anchor0, from)));
     foot_point[static_cast<size_t>(s)] = in_frame(root0_inv_, foot.anchor0);
     middle += 0.5 * foot_point[static_cast<size_t>(s)][1];
   }
@@ -402,10 +443,13 @@ void Jump3dController::landing_hips(const mjData* d, std::vector<double>& target
                 landing_offset_ * f[i] + landing_velocity_gain_ * com_vel_[static_cast<size_t>(i)] +
                 leg.lateral * lat[i];
     }
-    // The leg (hip to foot joint) at the knee's target, in the root's frame at zero hip
-    // angles (qpos0's).
-    const double qk = targets[static_cast<size_t>(leg.knee)];
-    const Vec3 v = add(leg.thigh, turn(leg.knee_axis, qk - leg.knee0, leg.shin));
+    // The leg (hip to foot joint) with the joints between at their targets, in the root's
+    // frame with the hip at its reference angles: s0 + R1 (s1 + R2 (s2 + ...)).
+    Vec3 v = leg.segments.back();
+    for (size_t i = leg.middle.size(); i-- > 0;) {
+      const double q = targets[static_cast<size_t>(leg.middle[i])];
+      v = add(leg.segments[i], turn(leg.axes[i], q - leg.middle0[i], v));
+    }
     const double length = std::sqrt(dot(v, v));
     if (length < 1e-6) continue;
     const CharacterJoint& hip = body_.joints[static_cast<size_t>(leg.hip_pitch)];
@@ -417,30 +461,11 @@ void Jump3dController::landing_hips(const mjData* d, std::vector<double>& target
     Vec3 w;
     mju_rotVecQuat(w.data(), r_world.data(), root_inv.data());
     w = scale(w, 1 / length);
-    const Vec3 u = scale(v, 1 / length);
-    // Roll first (its rotation keeps no component fixed but its own axis): make u's
-    // component along the pitch axis equal w's, which the pitch then keeps.
-    double roll = 0;
-    if (leg.hip_roll >= 0) {
-      const Vec3& ap = leg.pitch_axis;
-      const Vec3& ar = leg.roll_axis;
-      const double A = dot(u, ap), B = dot(cross(ar, u), ap), c = dot(w, ap);
-      const double R = std::hypot(A, B);
-      if (R > 1e-9) {
-        const double base = std::atan2(B, A), spread = std::acos(std::clamp(c / R, -1.0, 1.0));
-        const double r1 = std::remainder(base + spread, 2 * M_PI), r2 = std::remainder(base - spread, 2 * M_PI);
-        roll = std::fabs(r1) < std::fabs(r2) ? r1 : r2;
-      }
-    }
-    const Vec3 u1 = leg.hip_roll >= 0 ? turn(leg.roll_axis, roll, u) : u;
-    const Vec3& ap = leg.pitch_axis;
-    const Vec3 a_perp = sub(u1, scale(ap, dot(u1, ap)));
-    const Vec3 b_perp = sub(w, scale(ap, dot(w, ap)));
-    const double pitch = std::atan2(dot(ap, cross(a_perp, b_perp)), dot(a_perp, b_perp));
-    targets[static_cast<size_t>(leg.hip_pitch)] = clamp_to_range(hip, leg.pitch0 + pitch);
+    const HipAngles a = hip_angles_for(scale(v, 1 / length), leg.pitch_axis, leg.roll_axis, leg.hip_roll >= 0, w);
+    targets[static_cast<size_t>(leg.hip_pitch)] = clamp_to_range(hip, leg.pitch0 + a.pitch);
     if (leg.hip_roll >= 0) {
       const CharacterJoint& r = body_.joints[static_cast<size_t>(leg.hip_roll)];
-      targets[static_cast<size_t>(leg.hip_roll)] = clamp_to_range(r, leg.roll0 + roll);
+      targets[static_cast<size_t>(leg.hip_roll)] = clamp_to_range(r, leg.roll0 + a.roll);
     }
   }
 }

@@ -67,6 +67,20 @@
 
 namespace diverse {
 
+// The hip angles that point a leg in a given direction, for a hip of two orthogonal hinges
+// (pitch, then roll; `has_roll` false: pitch only). All vectors in one frame (the root's);
+// `leg` is the unit vector from the hip to the foot with both hip angles at their reference
+// (qpos0) values, `direction` the unit vector the leg should point along. Returns the
+// angles to add to the references, the roll nearest 0 of the two exact solutions; a
+// direction the hip cannot reach exactly (roll alone limits the component along the pitch
+// axis) gets the nearest one.
+struct HipAngles {
+  double pitch = 0, roll = 0;
+};
+HipAngles hip_angles_for(const std::array<double, 3>& leg, const std::array<double, 3>& pitch_axis,
+                         const std::array<double, 3>& roll_axis, bool has_roll,
+                         const std::array<double, 3>& direction);
+
 // Constants that are not optimized (documented defaults; the task file may override).
 struct Jump3dControllerConfig : ControllerConfig {
   bool landing_control = true;   // place the feet during fall
@@ -122,12 +136,17 @@ class Jump3dController : public Controller {
     double root = 0, torso = 0, foot = 0;
     std::vector<double> joints;
   };
+  // A leg at the model's qpos0, in the root's frame: the hip, then the joints between the
+  // hip and the foot (the knee; the bird's ankle), top down, and the foot's joint.
   struct LegGeometry {
-    int hip_pitch = -1, hip_roll = -1, knee = -1;  // Character::joints indices (-1: none)
-    double knee0 = 0, pitch0 = 0, roll0 = 0;        // their qpos0 values (rad)
-    std::array<double, 3> thigh{}, shin{};           // hip->knee, knee->ankle at qpos0, root frame
-    std::array<double, 3> knee_axis{}, pitch_axis{}, roll_axis{};  // root frame at qpos0
-    double lateral = 0;  // m, the ankle's standing offset along the root's y from the feet's middle
+    int hip_pitch = -1, hip_roll = -1;            // Character::joints indices (-1: none)
+    double pitch0 = 0, roll0 = 0;                 // their qpos0 values (rad)
+    std::array<double, 3> pitch_axis{}, roll_axis{};
+    std::vector<int> middle;                      // joints between hip and foot, top down
+    std::vector<double> middle0;                  // their qpos0 values
+    std::vector<std::array<double, 3>> axes;      // their axes
+    std::vector<std::array<double, 3>> segments;  // hip -> first, ..., last -> foot joint
+    double lateral = 0;  // m, the foot's standing offset along the root's y from the feet's middle
   };
 
   void enter(int phase, const mjModel* m, const mjData* d);

@@ -151,7 +151,7 @@ void read_simulation(const TomlReader& r, Task& task) {
 }
 
 void read_seed(const TomlReader& r, Task& task) {
-  r.only({"base", "object", "heights", "generations", "sigma", "popsize", "seed", "robustness"});
+  r.only({"base", "object", "heights", "distances", "generations", "sigma", "popsize", "seed", "robustness"});
   TaskSeed& s = task.seed;
   s.base = existing_file(r, "base");
   s.object = r.string("object", "");
@@ -171,6 +171,23 @@ void read_seed(const TomlReader& r, Task& task) {
   }
   if (!s.object.empty() && s.heights.empty()) {
     r.fail("heights", "expected continuation heights for the object (missing)");
+  }
+  if (r.has("distances")) {
+    const toml::array* a = r.raw().get("distances")->as_array();
+    if (a == nullptr || a->empty()) r.fail("distances", "expected a non-empty array of numbers in [-20, 20]");
+    for (const toml::node& n : *a) {
+      double v = 1e9;
+      if (auto f = n.as_floating_point()) v = f->get();
+      if (auto i = n.as_integer()) v = static_cast<double>(i->get());
+      if (!(v >= -20 && v <= 20)) r.fail("distances", "expected a non-empty array of numbers in [-20, 20]");
+      s.distances.push_back(v);
+    }
+    if (!s.object.empty()) r.fail("distances", "expected either an object's heights or landing distances, not both");
+    if (!task.constraints.landing) r.fail("distances", "expected a landing constraint to move (constraints.landing)");
+    if (s.distances.back() != task.constraints.landing_center) {
+      r.fail("distances", "expected the last distance to be the task's landing centre (" +
+                              std::to_string(task.constraints.landing_center) + ")");
+    }
   }
   s.generations = static_cast<int>(r.integer("generations", 1, 100000, s.generations));
   s.sigma = r.number("sigma", 1e-4, 1, s.sigma);

@@ -89,6 +89,9 @@ struct TaskSeed {
   std::string base;               // resolved path of the hand-authored start parameters
   std::string object;             // continuation object ("" = none)
   std::vector<double> heights;    // continuation heights (m), last = the task's height
+  // Continuation over where the character lands (m, the landing constraint's centre),
+  // last = the task's; instead of an object's heights.
+  std::vector<double> distances;
   int generations = 100;          // CMA-ES generations per continuation stage (max)
   double sigma = 0.08;            // initial CMA-ES step (normalized units)
   int popsize = 16;
