@@ -461,6 +461,7 @@ Character bind_character(std::shared_ptr<const CharacterSpec> spec_ptr, const mj
       j.anchor0[static_cast<size_t>(k)] = d->xanchor[3 * j.joint + k];
       j.axis0[static_cast<size_t>(k)] = d->xaxis[3 * j.joint + k];
     }
+    j.standing = m->qpos0[j.qpos];
   }
   mj_deleteData(d);
   c.height = std::isfinite(high - low) ? high - low : 0;

@@ -58,6 +58,14 @@ struct PhaseTimes {
 class Controller {
  public:
   virtual ~Controller() = default;
+  // Sets the rollout's initial state in d (qpos, qvel; the model's qpos0 at rest before),
+  // for controllers that start from a pose of their own (a walk starts in its first
+  // state's pose). Returns false, leaving d alone, when the task's start stands.
+  virtual bool start_state(const mjModel* m, mjData* d) {
+    (void)m;
+    (void)d;
+    return false;
+  }
   // Starts the state machine from the state in d (after mj_step1).
   virtual void reset(const mjModel* m, const mjData* d) = 0;
   // One control step (after mj_step1): transitions, targets, torques into `drive`.
