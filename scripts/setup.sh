@@ -6,6 +6,8 @@ packages=(
   libmujoco-dev libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libosmesa6-dev ffmpeg fonts-dejavu-core
+  libtinygltf-dev  # glTF export (src/io/gltf.h)
+  python3 python3-numpy python3-matplotlib  # examples/read_run.py (docs/python.md)
   jq  # scripts/reproduce-table1.sh reads the runs' summary.json
   chromium
 )

@@ -17,6 +17,8 @@
 #include "io/motion_record.h"
 #include "render/film_strip.h"
 #include "render/film_columns.h"
+#include "render/run_media.h"
+#include "render/view_plan.h"
 #include "task/evaluate.h"
 
 namespace diverse::cli {
@@ -76,12 +78,18 @@ void run(const SimulateArgs& args) {
 
   if (!args.no_film) {
     const auto model = SharedModel::from_file((dir / "model.xml").string());
-    FilmColumns columns = jump_film_columns(e, record);
+    FilmColumns columns = motion_film_columns(e.phases, record);
     std::vector<FilmRow> rows;
     rows.push_back(FilmRow{model->get(), "M0", std::move(columns.frames)});
+    RunMotion motion;
+    motion.record = record;
+    const auto frames = motion.sample(10.0);
+    const ViewPlan plan = plan_view(std::vector<PosedModel>{{model->get(), frames}});
     FilmStripOptions film;
     film.title = film_title(task.name, columns.names);
     film.ground_strips = task_ground_strips(task);
+    film.camera_direction = plan.direction;
+    film.follow = plan.follow;
     write_film_strip((dir / "filmstrip.png").string(), rows, film);
   }
   std::printf("wrote %s\n", (dir / "motion.json").string().c_str());

@@ -146,6 +146,49 @@ Vec3 leaf_end(const mjModel* m, int body) {
   return {0, 0, 0.05};
 }
 
+// A body whose every joint is a hinge at the body's origin, in a body frame not rotated
+// against its parent's (body_quat the identity), each axis along a BVH axis (+-X, +-Y, +-Z
+// after the change of axes), turns exactly as the BVH rotation channels of those axes in
+// the joints' order: MuJoCo composes a body's joints in order, each about its axis in the
+// frame the joints before it turned (R = R(a1, q1) R(a2, q2)), as a BVH joint composes its
+// channels (R = R_first R_second). Such a body gets one channel per hinge; a universal
+// joint (pitch then roll) becomes two.
+struct HingeChannel {
+  int axis = 0;       // 0 X, 1 Y, 2 Z (BVH axes)
+  double sign = 1.0;  // +1 if the hinge turns about +axis, -1 about -axis
+  int qpos = 0;       // the hinge's qpos address
+};
+
+std::vector<HingeChannel> hinge_channels(const mjModel* m, int body) {
+  std::vector<HingeChannel> out;
+  const int n = m->body_jntnum[body];
+  if (n == 0) return out;
+  const double* q = m->body_quat + 4 * body;
+  if (std::abs(q[0] - 1.0) > 1e-12 || std::abs(q[1]) > 1e-12 || std::abs(q[2]) > 1e-12 ||
+      std::abs(q[3]) > 1e-12)
+    return out;
+  for (int k = 0; k < n; ++k) {
+    const int jnt = m->body_jntadr[body] + k;
+    if (m->jnt_type[jnt] != mjJNT_HINGE) return {};
+    const double* p = m->jnt_pos + 3 * jnt;
+    if (std::abs(p[0]) > 1e-12 || std::abs(p[1]) > 1e-12 || std::abs(p[2]) > 1e-12) return {};
+    const Vec3 a = mujoco_to_bvh(m->jnt_axis + 3 * jnt);
+    HingeChannel h;
+    h.axis = -1;
+    for (int i = 0; i < 3; ++i) {
+      const bool others_zero = std::abs(a[(i + 1) % 3]) < 1e-12 && std::abs(a[(i + 2) % 3]) < 1e-12;
+      if (others_zero && std::abs(std::abs(a[i]) - 1.0) < 1e-12) {
+        h.axis = i;
+        h.sign = a[i] > 0 ? 1.0 : -1.0;
+      }
+    }
+    if (h.axis < 0) return {};
+    h.qpos = m->jnt_qposadr[jnt];
+    out.push_back(h);
+  }
+  return out;
+}
+
 // Tokens with their line numbers.
 struct Token {
   std::string text;
@@ -399,13 +442,20 @@ Bvh bvh_from_model(const mjModel* m, std::span<const std::vector<double>> qpos_f
   Bvh bvh;
   bvh.frame_time = 1.0 / fps;
   std::vector<int> bodies;
+  std::vector<std::vector<HingeChannel>> hinges;  // per BVH joint; empty: Euler channels
   std::function<void(int, int)> add = [&](int body, int parent) {
     BvhJoint j;
     j.name = joint_name(m, body);
     j.parent = parent;
     j.offset = parent < 0 ? Vec3{0, 0, 0} : mujoco_to_bvh(m->body_pos + 3 * body);
+    std::vector<HingeChannel> own = parent < 0 ? std::vector<HingeChannel>{} : hinge_channels(m, body);
     if (parent < 0) j.channels = {"Xposition", "Yposition", "Zposition"};
-    j.channels.insert(j.channels.end(), {"Zrotation", "Xrotation", "Yrotation"});
+    if (own.empty()) {
+      j.channels.insert(j.channels.end(), {"Zrotation", "Xrotation", "Yrotation"});
+    } else {
+      for (const HingeChannel& h : own) j.channels.push_back(std::string(1, "XYZ"[h.axis]) + "rotation");
+    }
+    hinges.push_back(std::move(own));
     const int index = static_cast<int>(bvh.joints.size());
     bvh.joints.push_back(j);
     bodies.push_back(body);
@@ -435,6 +485,13 @@ Bvh bvh_from_model(const mjModel* m, std::span<const std::vector<double>> qpos_f
     std::vector<double> values;
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       const int b = bodies[i];
+      if (!hinges[i].empty()) {
+        // One channel per hinge, in the body's joint order: the hinge's angle from its
+        // reference (MuJoCo turns a hinge by qpos - qpos0), signed by its axis.
+        for (const HingeChannel& h : hinges[i])
+          values.push_back(h.sign * (qpos[static_cast<std::size_t>(h.qpos)] - m->qpos0[h.qpos]) / kDegree);
+        continue;
+      }
       const Mat3 world = quat_to_mat(data->xquat + 4 * b);
       Mat3 local = world;
       if (bvh.joints[i].parent < 0) {

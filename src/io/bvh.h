@@ -26,9 +26,22 @@
 //     Site at the far end of their first geom.
 //   - Channels: the root has Xposition Yposition Zposition Zrotation Xrotation Yrotation,
 //     with its position absolute (the root OFFSET is 0, so importers that add the offset
-//     and importers that do not agree); every other joint has Zrotation Xrotation
-//     Yrotation. A planar character's angles are then all in Zrotation. Each angle is
-//     unwrapped over time (no jumps of 360 degrees), so a backflip's root turns smoothly.
+//     and importers that do not agree) and its orientation as intrinsic Z-X-Y angles (a
+//     free root, or a planar root's pitch, all in Zrotation).
+//   - A body whose joints are hinges at its origin, about axes along the BVH axes, in a
+//     frame not rotated against its parent's (every body of assets/characters/human2d and
+//     human3d) has one rotation channel per hinge, in MuJoCo's joint order, holding the
+//     hinge angle (qpos - qpos0) in degrees, negated for an axis along -X, -Y or -Z. MuJoCo
+//     turns a body's joints in order, each about its axis in the frame the joints before
+//     it turned, R = R(a1, q1) R(a2, q2), which is how a BVH joint composes its channels;
+//     so a universal joint (pitch about MuJoCo's -y, then roll about +-x) is the two
+//     channels "Zrotation Xrotation", a planar character's hinge (about -y) one Zrotation,
+//     and an animator sees each joint's own angles.
+//   - Every other body (ball joints, oblique or offset hinges, rotated body frames such as
+//     the bird robot's legs, bodies with no joint) has Zrotation Xrotation Yrotation: the
+//     Z-X-Y angles of its rotation in its parent, exact for any rotation.
+//   - Each angle is unwrapped over time (no jumps of 360 degrees), so a backflip's root
+//     turns smoothly.
 //
 // The body frames reproduce MuJoCo's exactly when every joint of a body sits at the body's
 // origin and only the root translates (true of assets/characters/*.xml); other models are

@@ -94,11 +94,17 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
                        {"link_masses", std::vector<double>(masses.data(), masses.data() + masses.size())},
                        {"samples", samples}};
 
+  j["replay"] = replay_record_json(record, info.model_path, json_path);
+  return j;
+}
+
+nlohmann::json replay_record_json(const StepRecorder& record, const fs::path& model_path,
+                                  const fs::path& json_path) {
   nlohmann::json damping = nlohmann::json::array();
   for (const auto& change : record.damping)
     damping.push_back({{"step", change.step}, {"values", change.values}});
   const fs::path base = json_path.has_parent_path() ? json_path.parent_path() : fs::path(".");
-  j["replay"] = {{"model", info.model_path.lexically_relative(base).generic_string()},
+  return {{"model", model_path.lexically_relative(base).generic_string()},
                  {"timestep", record.timestep},
                  {"nq", record.nq},
                  {"nu", record.nu},
@@ -108,7 +114,6 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
                  {"damping", damping},
                  {"ctrl", rows(record.ctrl, record.nu)},
                  {"qpos", rows(record.qpos, record.nq)}};
-  return j;
 }
 
 Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& parameters,

@@ -57,6 +57,14 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
                                   const MotionRecordInfo& info,
                                   const std::filesystem::path& json_path);
 
+// The "replay" object of a motion file for `record`, whose model is (or will be) saved at
+// model_path; the path is written relative to the motion file json_path. For motions made
+// by other programs than a task (a controller's own rollout, a test fixture), so that
+// `diverse replay`, render, gallery and export read them as any other.
+nlohmann::json replay_record_json(const StepRecorder& record,
+                                  const std::filesystem::path& model_path,
+                                  const std::filesystem::path& json_path);
+
 // Simulates `parameters` with recording on, saves the model to info.model_path and the
 // motion file to json_path. Returns the evaluation. Parameters holding shape scales
 // (holds_shape) run on that shape's scene, whose exact MJCF text is saved; otherwise

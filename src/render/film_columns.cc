@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 
 namespace diverse {
 
@@ -35,6 +37,95 @@ FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
   add("falling", p.peak() >= 0 && p.landing() >= 0 ? 0.5 * (p.peak() + p.landing()) : -1);
   add("touch-down", p.landing());
   add("end", end);
+  return columns;
+}
+
+bool last_stride(const PhaseTimes& p, int* first, int* length) {
+  // The phases reached, in order.
+  std::vector<int> reached;
+  for (std::size_t k = 0; k < p.names.size() && k < p.begin.size(); ++k)
+    if (p.begin[k] >= 0) reached.push_back(static_cast<int>(k));
+  const int n = static_cast<int>(reached.size());
+  const auto name = [&](int i) -> const std::string& { return p.names[static_cast<std::size_t>(reached[static_cast<std::size_t>(i)])]; };
+  // A stride begins where the cycle first began: at the name of the earliest phase that
+  // comes again (a walk's first state, not whichever state the motion ended in).
+  int start = -1;
+  for (int i = 0; i < n && start < 0; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (name(j) == name(i)) {
+        start = i;
+        break;
+      }
+  if (start < 0) return false;
+  for (int s = n - 2; s >= 0; --s) {
+    if (name(s) != name(start)) continue;
+    for (int len = 2; s + len < n; ++len) {
+      bool distinct = true;
+      for (int a = s; a < s + len && distinct; ++a)
+        for (int b = a + 1; b < s + len; ++b)
+          if (name(a) == name(b)) distinct = false;
+      if (!distinct) break;
+      if (name(s + len) == name(s)) {
+        *first = reached[static_cast<std::size_t>(s)];
+        *length = reached[static_cast<std::size_t>(s + len)] - reached[static_cast<std::size_t>(s)];
+        // Phases never reached inside the stride would leave gaps: not a clean cycle.
+        if (*length != len) continue;
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+FilmColumns motion_film_columns(const PhaseTimes& p, const StepRecorder& record) {
+  if (p.rise >= 0 || p.fall >= 0 || p.land >= 0) {
+    Evaluation e;
+    e.phases = p;
+    return jump_film_columns(e, record);
+  }
+  FilmColumns columns;
+  const double dt = record.timestep;
+  const double end = record.steps() * dt;
+  auto frame_at = [&](double t) {
+    const int steps = record.steps();
+    const long k = std::lround(t / dt) - 1;
+    if (k < 0 || steps == 0) return record.qpos0;
+    const long row = std::min<long>(k, steps - 1);
+    return std::vector<double>(record.qpos.begin() + row * record.nq,
+                               record.qpos.begin() + (row + 1) * record.nq);
+  };
+  auto add = [&](const std::string& name, double t) {
+    columns.names.push_back(name);
+    columns.frames.push_back(frame_at(t));
+  };
+  int first = 0, length = 0;
+  if (last_stride(p, &first, &length)) {
+    for (int k = first; k < first + length; ++k) {
+      const double begin = p.at(k), next = p.at(k + 1);
+      const std::string& name = p.names[static_cast<std::size_t>(k)];
+      add(name, begin);
+      add(std::string("mid ").append(name), 0.5 * (begin + next));
+    }
+    add(p.names[static_cast<std::size_t>(first)], p.at(first + length));
+    return columns;
+  }
+  // In the order they began (a controller that keeps each phase's latest begin, such as a
+  // walk's, then shows the last time through each).
+  std::vector<std::pair<double, std::size_t>> reached;
+  for (std::size_t k = 0; k < p.names.size() && k < p.begin.size(); ++k)
+    if (p.begin[k] >= 0) reached.emplace_back(p.begin[k], k);
+  std::stable_sort(reached.begin(), reached.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [begin, k] : reached) add(p.names[k], begin);
+  if (!reached.empty()) {
+    add("end", end);
+    return columns;
+  }
+  for (int k = 0; k < kEvenColumns; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%.2f s", end * k / (kEvenColumns - 1));
+    add(name, end * k / (kEvenColumns - 1));
+  }
   return columns;
 }
 

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <cstdio>
 #include <stdexcept>
+
+#include "render/view_plan.h"
 
 namespace diverse {
 namespace {
@@ -39,11 +42,21 @@ Image render_film_strip(std::span<const FilmRow> rows, const FilmStripOptions& o
 
   std::vector<PosedModel> motions;
   for (const FilmRow& row : rows) motions.push_back({row.model, row.frames});
+  const double aspect = static_cast<double>(tile_w) / tile_h;
+  std::vector<std::vector<std::array<double, 3>>> anchors(rows.size());
+  if (options.follow) {
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (const std::vector<double>& qpos : rows[r].frames)
+        anchors[r].push_back(qpos.empty() ? std::array<double, 3>{0, 0, 0}
+                                          : follow_anchor(rows[r].model, qpos));
+  }
   const SideCamera camera =
       options.camera ? *options.camera
-                     : fit_shared_camera(motions, static_cast<double>(tile_w) / tile_h,
-                                         options.ground_strips, options.camera_direction,
-                                         options.camera_margin);
+      : options.follow
+          ? fit_following_camera(motions, anchors, aspect, options.camera_direction,
+                                 options.camera_margin)
+          : fit_shared_camera(motions, aspect, options.ground_strips, options.camera_direction,
+                              options.camera_margin);
 
   // Layout: an optional title line, a line of column labels, then the rows of tiles with
   // their labels to the left.
@@ -91,7 +104,17 @@ Image render_film_strip(std::span<const FilmRow> rows, const FilmStripOptions& o
       const int x = grid_x + c * (tile_w + options.gap);
       canvas.fill_rect(x - 1, y - 1, tile_w + 2, tile_h + 2, options.tile_border);
       if (c < static_cast<int>(row.frames.size()) && !row.frames[c].empty()) {
-        canvas.paste(renderer->render(row.frames[c], camera), x, y);
+        if (options.follow) {
+          const auto& anchor = anchors[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
+          Image tile = renderer->render(row.frames[c], at_anchor(camera, anchor));
+          char where[48];
+          std::snprintf(where, sizeof where, "x %.1f m", anchor[0]);
+          draw_text(tile, where, tile_w - 6, tile_h - 6 - text_height(FontSize::kSmall), options.text,
+                    FontSize::kSmall, Align::kRight);
+          canvas.paste(tile, x, y);
+        } else {
+          canvas.paste(renderer->render(row.frames[c], camera), x, y);
+        }
       } else {
         canvas.fill_rect(x, y, tile_w, tile_h, options.background);
       }

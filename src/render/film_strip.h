@@ -6,7 +6,8 @@
 // shared camera fitted to all poses of all rows (and to any ground strips), so positions and
 // sizes compare across the whole picture. Scene objects of the models (boxes, obstacles) are
 // drawn as MuJoCo draws them; ground strips mark x-intervals of the floor such as a landing
-// region.
+// region. A film strip of a character that travels far (a walk) can follow it instead:
+// every tile centred on its own pose, with the same camera direction and distance.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -40,6 +41,9 @@ struct FilmStripOptions {
   SideCamera camera_direction;             // azimuth, elevation and fovy of the shared camera
   double camera_margin = 0.08;             // see fit_side_camera
   std::optional<SideCamera> camera;        // use this camera instead of fitting one
+  // Every tile centred on its own pose (render/view_plan.h): the camera's lookat is then
+  // relative to each pose's anchor, and each tile is labelled with where the character is.
+  bool follow = false;
   RenderStyle style;
   Rgb background{255, 255, 255};
   Rgb text{34, 34, 34};

@@ -15,6 +15,7 @@
 #include "metric/metric.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "render/view_plan.h"
 
 // Where the build put the page template (set for this file by the top-level CMakeLists).
 #ifndef DIVERSE_GALLERY_TEMPLATE
@@ -298,6 +299,76 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   return out;
 }
 
+// The run's progress per generation from log.jsonl (one record per CMA step; a generation's
+// last record is where the set stood after it): D, the best set's D, and every motion's C
+// and dmin. Long runs are thinned to at most max_points generations (evenly, keeping the
+// first and the last). A missing log gives an empty object; a malformed line is a
+// UserError naming it.
+nlohmann::json progress_data(const fs::path& log_file, int max_points) {
+  if (!fs::exists(log_file)) return nlohmann::json::object();
+  const std::string text = read_file(log_file);
+  std::vector<nlohmann::json> last;  // per generation, its last record
+  std::size_t start = 0;
+  for (int line = 1; start < text.size(); ++line) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::string row = text.substr(start, end - start);
+    start = end + 1;
+    if (row.empty()) continue;
+    nlohmann::json r;
+    try {
+      r = nlohmann::json::parse(row);
+      const long long g = r.at("generation").get<long long>();
+      (void)r.at("D").get<double>();
+      (void)r.at("best_D").get<double>();
+      if (!r.at("constraint").is_array() || !r.at("dmin").is_array()) throw std::invalid_argument("");
+      if (!last.empty() && last.back()["generation"].get<long long>() == g) last.back() = r;
+      else last.push_back(r);
+    } catch (const std::exception&) {
+      throw UserError(log_file.string() + ": line " + std::to_string(line) +
+                      ": expected a JSON record with generation, D, best_D, constraint and dmin");
+    }
+  }
+  std::vector<std::size_t> keep;
+  const std::size_t n = last.size();
+  const std::size_t want = static_cast<std::size_t>(std::max(2, max_points));
+  for (std::size_t k = 0; k < std::min(n, want); ++k) {
+    const std::size_t index = n <= want ? k : static_cast<std::size_t>(std::llround(static_cast<double>(k) * (n - 1) / (want - 1)));
+    if (keep.empty() || keep.back() != index) keep.push_back(index);
+  }
+  nlohmann::json generation = nlohmann::json::array(), d = nlohmann::json::array(),
+                 best = nlohmann::json::array(), c = nlohmann::json::array(),
+                 dmin = nlohmann::json::array();
+  for (std::size_t k : keep) {
+    const nlohmann::json& r = last[k];
+    generation.push_back(r["generation"]);
+    d.push_back(r["D"]);
+    best.push_back(r["best_D"]);
+    c.push_back(r["constraint"]);
+    dmin.push_back(r["dmin"]);
+  }
+  return {{"generations_total", n}, {"generation", generation}, {"D", d}, {"best_D", best},
+          {"constraint", c}, {"dmin", dmin}};
+}
+
+// For a run whose bodies varied (vary includes "shape"): each motion's link-length scales
+// (summary.json motions[i].shape_scales), by parameter name in the order of the first.
+nlohmann::json shape_data(const nlohmann::json& summary) {
+  const nlohmann::json vary = summary.value("vary", nlohmann::json::array());
+  if (std::find(vary.begin(), vary.end(), "shape") == vary.end()) return nullptr;
+  nlohmann::json names = nlohmann::json::array();
+  nlohmann::json scales = nlohmann::json::array();
+  for (const nlohmann::json& m : summary["motions"]) {
+    const nlohmann::json s = m.value("shape_scales", nlohmann::json::object());
+    if (names.empty())
+      for (auto it = s.begin(); it != s.end(); ++it) names.push_back(it.key());
+    nlohmann::json row = nlohmann::json::array();
+    for (const auto& name : names) row.push_back(s.contains(name) ? s[name] : nlohmann::json(1.0));
+    scales.push_back(row);
+  }
+  if (names.empty()) return nullptr;
+  return {{"names", names}, {"scales", scales}};
+}
+
 }  // namespace
 
 fs::path gallery_template_path() {
@@ -367,6 +438,7 @@ nlohmann::json model_json(const mjModel* m) {
     has_floor = true;
   }
   return {{"bodies", bodies},
+          {"root", root_body(m) - 1},  // index into bodies of the root (-1: none)
           {"geoms", geoms},
           {"floor", has_floor ? nlohmann::json(round4(floor)) : nlohmann::json(nullptr)}};
 }
@@ -401,7 +473,20 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
 
   nlohmann::json models = nlohmann::json::array();
   nlohmann::json motions = nlohmann::json::array();
-  for (const RunMotion& m : run.motions) {
+  // How the page first looks at the motions (render/view_plan.h): from the side or
+  // three-quarters, following each character or not; the same choice as the film strip's.
+  std::vector<std::vector<std::vector<double>>> sampled;
+  for (const RunMotion& m : run.motions) sampled.push_back(m.sample(options.fps));
+  std::vector<PosedModel> posed;
+  for (std::size_t i = 0; i < run.motions.size(); ++i) posed.push_back({run.motions[i].model->get(), sampled[i]});
+  const ViewPlan plan = plan_view(posed);
+  data["view"] = {{"three_quarter", plan.three_quarter},
+                  {"follow", plan.follow},
+                  {"heading", plan.heading},
+                  {"azimuth", plan.direction.azimuth},
+                  {"elevation", plan.direction.elevation}};
+  for (std::size_t i = 0; i < run.motions.size(); ++i) {
+    const RunMotion& m = run.motions[i];
     motions.push_back({{"label", m.label},
                        {"index", m.index},
                        {"model", add_model(models, m.model->get())},
@@ -411,13 +496,15 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                        {"failed", m.failed},
                        {"status", m.status()},
                        {"duration", m.duration()},
-                       {"frames", body_frames_json(m.model->get(), m.sample(options.fps))}});
+                       {"frames", body_frames_json(m.model->get(), sampled[i])}});
   }
   nlohmann::json strips = nlohmann::json::array();
   for (const GroundStrip& g : run.ground_strips) strips.push_back({round4(g.x_min), round4(g.x_max)});
   data["scene"] = {{"strips", strips}};
   data["motions"] = motions;
   data["distances"] = s.contains("distances") ? s["distances"] : nlohmann::json::object();
+  data["progress"] = progress_data(run.dir / "log.jsonl", options.max_progress_points);
+  data["shape"] = shape_data(s);
   data["notes"] = nlohmann::json::array();
   if (!run.task_note.empty()) data["notes"].push_back("landing region not drawn: " + run.task_note);
   if (options.paths && run.motions.size() > 1) {

@@ -23,6 +23,10 @@
 //     `max_path_candidates` of them, evenly spaced, to measure distances), and the point
 //     nearest to each fraction of the result's distance is simulated again with
 //     recording on. Points that miss the task (C > 0) are marked.
+//   - the run's progress for the plots panel, from log.jsonl: per generation (the last CMA
+//     step of each), D of the current set, D of the best set so far, and every motion's
+//     constraint value C and dmin; at most max_progress_points generations, thinned evenly;
+//   - for a run whose bodies varied, every motion's link-length scales (summary.json).
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -42,6 +46,7 @@ struct GalleryOptions {
   bool paths = true;              // simulate optimization path points (needs the task file)
   std::vector<double> path_fractions{0.0, 0.25, 0.5, 0.75, 1.0};
   int max_path_candidates = 64;   // path points per variation simulated to measure distances
+  int max_progress_points = 400;  // generations of log.jsonl kept for the plots (thinned evenly)
   int threads = 0;                // simulation threads; 0 = one per core
   std::filesystem::path page_template;  // "" = gallery_template_path()
 };

@@ -92,19 +92,27 @@ void Bounds::merge(const Bounds& other) {
   add(other.hi);
 }
 
-Bounds pose_bounds(const mjModel* model, std::span<const std::vector<double>> frames) {
-  Bounds bounds;
+std::vector<Bounds> pose_bounds_each(const mjModel* model,
+                                     std::span<const std::vector<double>> frames) {
+  std::vector<Bounds> each(frames.size());
   std::unique_ptr<mjData, DataDeleter> data(mj_makeData(model));
-  for (const std::vector<double>& qpos : frames) {
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::vector<double>& qpos = frames[k];
     if (qpos.empty()) continue;  // a tile left empty on purpose
     check_qpos(model, qpos.size());
     std::copy(qpos.begin(), qpos.end(), data->qpos);
     mj_kinematics(model, data.get());
     for (int g = 0; g < model->ngeom; ++g) {
       if (model->geom_bodyid[g] == 0 || model->geom_group[g] > 2) continue;
-      add_geom_bounds(model, data.get(), g, bounds);
+      add_geom_bounds(model, data.get(), g, each[k]);
     }
   }
+  return each;
+}
+
+Bounds pose_bounds(const mjModel* model, std::span<const std::vector<double>> frames) {
+  Bounds bounds;
+  for (const Bounds& b : pose_bounds_each(model, frames)) bounds.merge(b);
   return bounds;
 }
 

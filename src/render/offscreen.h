@@ -75,6 +75,9 @@ struct Bounds {
 // capsules, cylinders, boxes and ellipsoids are bounded exactly, meshes and other shapes by
 // their bounding sphere.
 Bounds pose_bounds(const mjModel* model, std::span<const std::vector<double>> frames);
+// The same box for each frame on its own (an empty qpos gives an empty box).
+std::vector<Bounds> pose_bounds_each(const mjModel* model,
+                                     std::span<const std::vector<double>> frames);
 
 // Height (m) of the model's floor: the first plane geom of the world body whose normal
 // points up. Empty if the model has none.

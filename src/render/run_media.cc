@@ -11,6 +11,7 @@
 #include "render/film_strip.h"
 #include "render/video.h"
 #include "render/film_columns.h"
+#include "render/view_plan.h"
 #include "task/task.h"
 
 namespace diverse {
@@ -172,15 +173,23 @@ void write_run_film_strip(const RunView& run, const fs::path& png) {
   std::vector<FilmRow> rows;
   std::vector<std::string> names;
   for (const RunMotion& m : run.motions) {
-    Evaluation e;
-    e.phases = m.phases;
-    FilmColumns columns = jump_film_columns(e, m.record);
+    FilmColumns columns = motion_film_columns(m.phases, m.record);
     if (columns.names.size() > names.size()) names = columns.names;
     rows.push_back(FilmRow{m.model->get(), m.label, std::move(columns.frames)});
   }
+  // The direction and whether to follow come from the whole motions, not only the tiles.
+  std::vector<std::vector<std::vector<double>>> all(run.motions.size());
+  std::vector<PosedModel> posed;
+  for (std::size_t i = 0; i < run.motions.size(); ++i) {
+    all[i] = run.motions[i].sample(10.0);
+    posed.push_back({run.motions[i].model->get(), all[i]});
+  }
+  const ViewPlan plan = plan_view(posed);
   FilmStripOptions film;
   film.title = film_title(run.task_name + ", metric " + run.metric, names);
   film.ground_strips = run.ground_strips;
+  film.camera_direction = plan.direction;
+  film.follow = plan.follow;
   fs::create_directories(png.has_parent_path() ? png.parent_path() : fs::path("."));
   write_film_strip(png.string(), rows, film);
 }
@@ -200,8 +209,19 @@ std::vector<fs::path> write_run_videos(const RunView& run, const RunVideoOptions
     length = std::max(length, frames[i].size());
   }
   RenderStyle style;
-  const SideCamera camera = fit_shared_camera(posed, static_cast<double>(tile_w) / tile_h,
-                                              run.ground_strips, SideCamera{}, 0.06);
+  const ViewPlan plan = plan_view(posed);
+  const double aspect = static_cast<double>(tile_w) / tile_h;
+  // Following: each tile's camera moves with its own character's root, averaged over a
+  // second of motion time so the stride's sway does not shake the picture.
+  std::vector<std::vector<std::array<double, 3>>> anchors(run.motions.size());
+  if (plan.follow) {
+    const int half_window = std::max(1, static_cast<int>(std::lround(0.5 * options.fps / speed)));
+    for (std::size_t i = 0; i < run.motions.size(); ++i)
+      anchors[i] = follow_anchors(run.motions[i].model->get(), frames[i], half_window);
+  }
+  const SideCamera camera =
+      plan.follow ? fit_following_camera(posed, anchors, aspect, plan.direction, 0.06)
+                  : fit_shared_camera(posed, aspect, run.ground_strips, plan.direction, 0.06);
   std::vector<std::unique_ptr<OffscreenRenderer>> renderers;
   for (const RunMotion& m : run.motions) {
     renderers.push_back(std::make_unique<OffscreenRenderer>(m.model->get(), tile_w, tile_h, style));
@@ -249,7 +269,7 @@ std::vector<fs::path> write_run_videos(const RunView& run, const RunVideoOptions
       const auto k = static_cast<std::size_t>(i);
       const RunMotion& m = run.motions[k];
       if (t < frames[k].size()) {
-        last[k] = renderers[k]->render(frames[k][t], camera);
+        last[k] = renderers[k]->render(frames[k][t], plan.follow ? at_anchor(camera, anchors[k][t]) : camera);
         label_tile(last[k], m, t + 1 == frames[k].size() ? "end" : "");
         single.fill(kBackground);
         std::string title = run.task_name;

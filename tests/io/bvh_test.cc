@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "physics/model.h"
+#include "support/stance_run.h"
 
 namespace diverse {
 namespace {
@@ -114,7 +115,11 @@ TEST(BvhExport, PlanarHumanRoundTripsAndMatchesMujoco) {
   ASSERT_EQ(static_cast<int>(bvh.joints.size()), m->nbody - 1);
   EXPECT_EQ(bvh.joints[0].name, "pelvis");
   EXPECT_EQ(bvh.joints[0].parent, -1);
-  EXPECT_EQ(bvh.channel_count(), 3 + 3 * (m->nbody - 1));
+  // The root: 3 positions and 3 angles; every other body turns on one hinge about -y, a
+  // single Zrotation channel holding the hinge's angle.
+  EXPECT_EQ(bvh.channel_count(), 6 + (m->nbody - 2));
+  for (std::size_t j = 1; j < bvh.joints.size(); ++j)
+    EXPECT_EQ(bvh.joints[j].channels, std::vector<std::string>{"Zrotation"}) << bvh.joints[j].name;
   EXPECT_EQ(bvh.frame_count(), 61);
   EXPECT_DOUBLE_EQ(bvh.frame_time, 1.0 / 30.0);
   // The knee's offset is the shin's body position (0, 0, -0.39) in BVH axes.
@@ -150,14 +155,13 @@ TEST(BvhExport, PlanarHumanRoundTripsAndMatchesMujoco) {
                                                    bvh.frames[static_cast<std::size_t>(f - 1)][root_z]));
   EXPECT_LT(largest_step, 10.0);
   EXPECT_NEAR(bvh.frames.back()[root_z], 360.0, 1e-6);
-  for (const auto& values : bvh.frames) {
+  const int knee = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "knee_l")];
+  const std::size_t knee_channel = 6 + static_cast<std::size_t>(shin - 1);
+  for (std::size_t f = 0; f < bvh.frames.size(); ++f) {
+    const auto& values = bvh.frames[f];
     EXPECT_NEAR(values[4], 0.0, 1e-9);  // root Xrotation
     EXPECT_NEAR(values[5], 0.0, 1e-9);  // root Yrotation
-    for (std::size_t j = 1; j < bvh.joints.size(); ++j) {
-      const std::size_t v = 6 + 3 * (j - 1);
-      EXPECT_NEAR(values[v + 1], 0.0, 1e-9) << bvh.joints[j].name;
-      EXPECT_NEAR(values[v + 2], 0.0, 1e-9) << bvh.joints[j].name;
-    }
+    EXPECT_NEAR(values[knee_channel], frames[f][static_cast<std::size_t>(knee)] * 180 / kPi, 1e-9);
   }
 }
 
@@ -187,6 +191,78 @@ TEST(BvhExport, ThreeDimensionalModelMatchesMujoco) {
   const Bvh back = parse_bvh(bvh_text(bvh), "human3d.bvh");
   EXPECT_EQ(back.frame_count(), 20);
   expect_matches_mujoco(m, frames, back, bodies, 1e-3);
+}
+
+// qpos every `every` steps of a recorded rollout, from the initial state on.
+std::vector<std::vector<double>> recorded_frames(const StepRecorder& r, int every) {
+  std::vector<std::vector<double>> frames{r.qpos0};
+  for (int k = every - 1; k < r.steps(); k += every)
+    frames.emplace_back(r.qpos.begin() + static_cast<long>(k) * r.nq,
+                        r.qpos.begin() + static_cast<long>(k + 1) * r.nq);
+  return frames;
+}
+
+// The 3D human pushed forward and to its left, 1.5 s of stance control: its universal
+// joints (pitch then roll) are two channels holding the two hinge angles, its hinges one,
+// and the file's forward kinematics puts every body where MuJoCo does, in every frame.
+TEST(BvhExport, Human3dUniversalJointsAreTwoHingeChannelsAndMatchMujoco) {
+  const auto motion = test_support::stance_motion("human3d", {0.3, 0.3, 0.0}, 1.5);
+  const mjModel* m = motion.model->get();
+  const auto frames = recorded_frames(motion.record, 17);  // every 34 ms
+  std::vector<int> bodies;
+  const Bvh bvh = bvh_from_model(m, frames, 30.0, &bodies);
+  ASSERT_EQ(static_cast<int>(bvh.joints.size()), m->nbody - 1);
+  EXPECT_EQ(bvh.joints[0].channels, (std::vector<std::string>{"Xposition", "Yposition", "Zposition",
+                                                              "Zrotation", "Xrotation", "Yrotation"}));
+  const std::vector<std::string> universal{"Zrotation", "Xrotation"};
+  const std::vector<std::string> hinge{"Zrotation"};
+  for (const char* name : {"thigh_l", "thigh_r", "foot_l", "foot_r", "torso", "head", "upperarm_l",
+                           "upperarm_r", "hand_l", "hand_r"})
+    EXPECT_EQ(bvh.joints[static_cast<std::size_t>(bvh.find(name))].channels, universal) << name;
+  for (const char* name : {"shin_l", "shin_r", "forearm_l", "forearm_r"})
+    EXPECT_EQ(bvh.joints[static_cast<std::size_t>(bvh.find(name))].channels, hinge) << name;
+  // 6 root channels, 10 universal joints, 4 hinges: the 24 internal degrees of freedom.
+  EXPECT_EQ(bvh.channel_count(), 6 + 24);
+
+  // The channel values are the hinge angles in degrees; the right roll turns about -x,
+  // so its channel holds minus its angle. The push moves them.
+  auto channel = [&](const char* body, int k) {
+    std::size_t v = 0;
+    for (int j = 0; j < bvh.find(body); ++j) v += bvh.joints[static_cast<std::size_t>(j)].channels.size();
+    return v + static_cast<std::size_t>(k);
+  };
+  const int pitch_l = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "hip_pitch_l")];
+  const int roll_r = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "hip_roll_r")];
+  double roll_range = 0;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    EXPECT_NEAR(bvh.frames[f][channel("thigh_l", 0)], frames[f][static_cast<std::size_t>(pitch_l)] * 180 / kPi, 1e-9);
+    EXPECT_NEAR(bvh.frames[f][channel("thigh_r", 1)], -frames[f][static_cast<std::size_t>(roll_r)] * 180 / kPi, 1e-9);
+    roll_range = std::max(roll_range, std::abs(frames[f][static_cast<std::size_t>(roll_r)] - frames[0][static_cast<std::size_t>(roll_r)]));
+  }
+  EXPECT_GT(roll_range * 180 / kPi, 0.5) << "the sideways push turns the hip roll";
+
+  const Bvh back = parse_bvh(bvh_text(bvh), "human3d.bvh");
+  expect_matches_mujoco(m, frames, bvh, bodies, 1e-9);
+  expect_matches_mujoco(m, frames, back, bodies, 1e-4);
+}
+
+// The bird robot's hinges have reference angles (ref: qpos0 is not 0, and MuJoCo turns a
+// hinge by qpos - qpos0): its channels hold the angle from the reference, and the file
+// reproduces MuJoCo's poses.
+TEST(BvhExport, BirdRobotHingesWithReferenceAnglesMatchMujoco) {
+  const auto motion = test_support::stance_motion("robot3d", {-0.3, 0.2, 0.0}, 1.0);
+  const mjModel* m = motion.model->get();
+  const auto frames = recorded_frames(motion.record, 17);
+  std::vector<int> bodies;
+  const Bvh bvh = bvh_from_model(m, frames, 30.0, &bodies);
+  EXPECT_EQ(bvh.joints[static_cast<std::size_t>(bvh.find("thigh_l"))].channels,
+            (std::vector<std::string>{"Zrotation", "Xrotation"}));
+  EXPECT_EQ(bvh.joints[static_cast<std::size_t>(bvh.find("shank_l"))].channels,
+            std::vector<std::string>{"Zrotation"});
+  const int knee = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "knee_l")];
+  EXPECT_NEAR(m->qpos0[knee], 1.0, 1e-12);
+  expect_matches_mujoco(m, frames, bvh, bodies, 1e-9);
+  expect_matches_mujoco(m, frames, parse_bvh(bvh_text(bvh), "robot3d.bvh"), bodies, 1e-4);
 }
 
 TEST(BvhExport, ModelWithTwoMovingTreesIsAUserError) {

@@ -259,6 +259,58 @@ TEST_F(RunMediaTest, GalleryDataHasPosesConstraintsAndThePath) {
   }
 }
 
+// The plots panel's data: the run's progress per generation from log.jsonl (a generation's
+// last record), thinned evenly to at most max_progress_points generations, and the bodies'
+// link-length scales of a run whose shape varied; a malformed log line is a one-line error.
+TEST_F(RunMediaTest, GalleryDataHasProgressAndShapes) {
+  const fs::path dir = copy("progress");
+  std::string log;
+  for (int g = 1; g <= 10; ++g)
+    for (int v = 1; v <= 2; ++v)
+      log += nlohmann::json({{"generation", g}, {"step", 2 * g + v - 2}, {"variation", v},
+                             {"D", 10.0 * g + v}, {"best_D", 10.0 * g + v + 0.5},
+                             {"constraint", {0.0, 1.0 / g}}, {"dmin", {1.5, 1.0 * g}},
+                             {"evaluations", 16 * g}}).dump() + "\n";
+  write_file_atomic(dir / "log.jsonl", log);
+  nlohmann::json summary = read_json(dir / "summary.json");
+  summary["vary"] = {"control", "shape"};
+  summary["motions"][0]["shape_scales"] = {{"thigh", 1.0}, {"shin", 1.0}};
+  summary["motions"][1]["shape_scales"] = {{"thigh", 1.4}, {"shin", 0.7}};
+  write_json_atomic(dir / "summary.json", summary);
+
+  GalleryOptions options;
+  options.paths = false;
+  options.max_progress_points = 4;
+  const nlohmann::json data = gallery_data(load_run_view(dir), options);
+  const nlohmann::json& p = data["progress"];
+  EXPECT_EQ(p["generations_total"], 10);
+  EXPECT_EQ(p["generation"], nlohmann::json({1, 4, 7, 10}));
+  EXPECT_EQ(p["D"], nlohmann::json({12.0, 42.0, 72.0, 102.0}));  // each generation's last step
+  EXPECT_EQ(p["best_D"][3], 102.5);
+  EXPECT_EQ(p["constraint"][3], nlohmann::json({0.0, 0.1}));
+  EXPECT_EQ(p["dmin"][1], nlohmann::json({1.5, 4.0}));
+  EXPECT_EQ(data["shape"]["names"], nlohmann::json({"shin", "thigh"}));
+  EXPECT_EQ(data["shape"]["scales"][1], nlohmann::json({0.7, 1.4}));
+  EXPECT_TRUE(data["view"].is_object());
+  EXPECT_FALSE(data["view"]["three_quarter"].get<bool>()) << "the planar human is seen from the side";
+
+  write_file_atomic(dir / "log.jsonl", log + "{\"generation\": 11}\n");
+  try {
+    gallery_data(load_run_view(dir), options);
+    FAIL() << "expected a UserError";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "log.jsonl").string() +
+                                         ": line 21: expected a JSON record with generation, D, best_D, constraint and dmin");
+  }
+  // Without log.jsonl and an unshaped run: no progress, no shapes.
+  fs::remove(dir / "log.jsonl");
+  summary.erase("vary");
+  write_json_atomic(dir / "summary.json", summary);
+  const nlohmann::json bare = gallery_data(load_run_view(dir), options);
+  EXPECT_TRUE(bare["progress"].empty());
+  EXPECT_TRUE(bare["shape"].is_null());
+}
+
 TEST(GalleryHtml, DataReplacesTheDataMarkerAndCannotEndTheScript) {
   const std::string page = "<script id=d type=application/json>__DIVERSE_GALLERY_DATA__</script>";
   const std::string html = gallery_html(page, {{"name", "</script><b>"}});
@@ -292,6 +344,15 @@ TEST_F(RunMediaTest, CommandsWriteTheirFiles) {
     EXPECT_EQ(file.joints.size(), 17u);
     EXPECT_EQ(file.frame_count(), static_cast<int>(run.motions[static_cast<std::size_t>(i)].sample(60).size()));
   }
+
+  const Result gltf = run_cli("export " + dir.string() + " --gltf");
+  ASSERT_EQ(gltf.status, 0) << gltf.output;
+  for (const char* name : {"m0.glb", "m1.glb", "all.glb"}) {
+    const std::string bytes = read_file(dir / "export" / name);
+    ASSERT_GT(bytes.size(), 12u) << name;
+    EXPECT_EQ(bytes.substr(0, 4), "glTF") << name;  // the binary container's magic
+  }
+  EXPECT_NE(gltf.output.find("all.glb  (2 motions side by side"), std::string::npos) << gltf.output;
 }
 
 TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
@@ -305,7 +366,7 @@ TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
   const fs::path unfinished = copy("unfinished");
   fs::remove(unfinished / "summary.json");
 
-  for (const std::string command : {"render", "gallery", "export --bvh"}) {
+  for (const std::string command : {"render", "gallery", "export --bvh", "export --gltf"}) {
     SCOPED_TRACE(command);
     Result r = run_cli(command + " " + empty.string());
     EXPECT_EQ(r.status, 2);
@@ -336,7 +397,7 @@ TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
   EXPECT_EQ(r.output, "diverse: error: --fps: expected 30 or 60, got 45\n");
   r = run_cli("export " + dir_.string());
   EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.output, "diverse: error: export: choose a format: --bvh\n");
+  EXPECT_EQ(r.output, "diverse: error: export: choose a format: --bvh, --gltf or both\n");
 
   // The page template missing, with no node to build it.
   r = run_cli("gallery " + dir_.string(), "PATH=/nonexistent DIVERSE_GALLERY_TEMPLATE=/nonexistent/t.html");

@@ -8,6 +8,7 @@
 // Poses between samples are interpolated (positions linearly, orientations by slerp).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { fillPlots } from './plots.js';
 
 const data = JSON.parse(document.getElementById('gallery-data').textContent);
 const $ = (id) => document.getElementById(id);
@@ -110,7 +111,7 @@ function fillDistances() {
 // A track: one motion's frames on one model.
 function makeTrack(source, label) {
   const f = source.frames;
-  return {
+  const track = {
     label,
     model: source.model,
     count: f.count,
@@ -118,6 +119,42 @@ function makeTrack(source, label) {
     data: Float32Array.from(f.data),
     duration: source.duration,
   };
+  track.anchors = followAnchors(track);
+  return track;
+}
+
+// Where a camera that follows this track looks in each frame: the root body's x and y,
+// averaged over half a second either side, so the stride's sway does not shake the view
+// (as the videos do; src/render/view_plan.h).
+function followAnchors(track) {
+  const root = Math.max(0, data.models[track.model].root ?? 0);
+  const half = Math.max(1, Math.round(0.5 * data.fps));
+  const raw = new Float32Array(2 * track.count);
+  for (let k = 0; k < track.count; ++k) {
+    const o = (k * track.bodies + root) * 7;
+    raw[2 * k] = track.data[o];
+    raw[2 * k + 1] = track.data[o + 1];
+  }
+  const out = new Float32Array(2 * track.count);
+  for (let k = 0; k < track.count; ++k) {
+    const a = Math.max(0, k - half);
+    const b = Math.min(track.count - 1, k + half);
+    let x = 0;
+    let y = 0;
+    for (let j = a; j <= b; ++j) { x += raw[2 * j]; y += raw[2 * j + 1]; }
+    out[2 * k] = x / (b - a + 1);
+    out[2 * k + 1] = y / (b - a + 1);
+  }
+  return out;
+}
+
+function anchorAt(track, t) {
+  const f = Math.min(Math.max(t, 0) * data.fps, track.count - 1);
+  const i0 = Math.floor(f);
+  const i1 = Math.min(i0 + 1, track.count - 1);
+  const a = f - i0;
+  const A = track.anchors;
+  return new THREE.Vector3(A[2 * i0] + a * (A[2 * i1] - A[2 * i0]), A[2 * i0 + 1] + a * (A[2 * i1 + 1] - A[2 * i0 + 1]), 0);
 }
 
 const tiles = data.motions.map((m, i) => {
@@ -177,20 +214,69 @@ scene.add(sun, sun.target);
 // The extent of everything that moves (to place the floor and the light), and of the
 // motions the run found and the landing region (to place the camera: path points that
 // fall far away may leave the view, as a zoom out shows).
+// Each body's geoms as (offset in the body, radius of a sphere around the geom), so boxes
+// cover the bodies themselves (a head reaches well above its body's origin at the neck).
+const GEOM_RADIUS = {
+  capsule: (s) => s[0] + s[1], sphere: (s) => s[0], ellipsoid: (s) => Math.max(s[0], s[1], s[2]),
+  cylinder: (s) => Math.hypot(s[0], s[1]), box: (s) => Math.hypot(s[0], s[1], s[2]),
+};
+const geomSpheres = data.models.map((model) => model.bodies.map((_, b) => model.geoms
+  .filter((g) => g.body === b && GEOM_RADIUS[g.type])
+  .map((g) => ({ pos: new THREE.Vector3().fromArray(g.pos), r: GEOM_RADIUS[g.type](g.size) }))));
+
+// Calls visit(point, radius, frame) for every geom of every body in every frame of a track.
+function eachGeom(track, visit) {
+  const d = track.data;
+  const spheres = geomSpheres[track.model];
+  const q = new THREE.Quaternion();
+  const p = new THREE.Vector3();
+  for (let f = 0; f < track.count; ++f) {
+    for (let b = 0; b < track.bodies; ++b) {
+      const o = (f * track.bodies + b) * 7;
+      q.set(d[o + 4], d[o + 5], d[o + 6], d[o + 3]);
+      for (const s of spheres[b] || []) {
+        p.copy(s.pos).applyQuaternion(q).add(new THREE.Vector3(d[o], d[o + 1], d[o + 2]));
+        visit(p, s.r, f);
+      }
+    }
+  }
+}
+
 function extent(tracks) {
   const box = new THREE.Box3();
-  const p = new THREE.Vector3();
   for (const track of tracks) {
-    const d = track.data;
-    for (let k = 0; k < d.length; k += 7) box.expandByPoint(p.set(d[k], d[k + 1], d[k + 2]));
+    eachGeom(track, (p, r) => {
+      box.expandByPoint(new THREE.Vector3(p.x - r, p.y - r, p.z - r));
+      box.expandByPoint(new THREE.Vector3(p.x + r, p.y + r, p.z + r));
+    });
   }
   if (box.isEmpty()) box.set(new THREE.Vector3(-1, -0.3, 0), new THREE.Vector3(1, 0.3, 1.6));
-  box.expandByScalar(0.15);  // body radius and a little air
+  box.expandByScalar(0.05);  // a little air
   return box;
 }
+// The same box with every pose taken relative to its track's anchor: what a camera that
+// follows has to keep in view.
+function relativeExtent(tracks) {
+  const box = new THREE.Box3();
+  for (const track of tracks) {
+    eachGeom(track, (p, r, f) => {
+      const x = p.x - track.anchors[2 * f];
+      const y = p.y - track.anchors[2 * f + 1];
+      box.expandByPoint(new THREE.Vector3(x - r, y - r, p.z - r));
+      box.expandByPoint(new THREE.Vector3(x + r, y + r, p.z + r));
+    });
+  }
+  if (box.isEmpty()) box.set(new THREE.Vector3(-1, -0.3, 0), new THREE.Vector3(1, 0.3, 1.6));
+  box.expandByScalar(0.05);
+  return box;
+}
+const view = data.view || { three_quarter: false, follow: false };
 const floorZ = data.models.find((m) => m.floor !== null)?.floor ?? 0;
 const bounds = extent(tiles.flatMap((t) => [t.main, ...t.pathTracks]));
-const viewBounds = extent(tiles.map((t) => t.main));
+const globalViewBounds = extent(tiles.map((t) => t.main));
+const viewBounds = globalViewBounds;
+const followBounds = relativeExtent(tiles.map((t) => t.main));
+followBounds.min.z = Math.min(followBounds.min.z, floorZ);
 for (const box of [bounds, viewBounds]) {
   box.min.z = Math.min(box.min.z, floorZ);
   for (const [x0, x1] of data.scene?.strips || []) {
@@ -213,10 +299,14 @@ const center = bounds.getCenter(new THREE.Vector3());
   const band = 0.5;
   const light = layer(0xdcdcda, 2);
   const dark = layer(0xc4c4c1, 2);
-  const geometry = new THREE.PlaneGeometry(band, 2);
+  // The track is 2 m wide for planar characters; a 3D character may move sideways, so its
+  // track spans everything that moves, with a metre to spare on either side.
+  const trackY0 = view.three_quarter ? Math.min(-1, bounds.min.y - 1) : -1;
+  const trackY1 = view.three_quarter ? Math.max(1, bounds.max.y + 1) : 1;
+  const geometry = new THREE.PlaneGeometry(band, trackY1 - trackY0);
   for (let k = Math.floor((bounds.min.x - 6) / band); k < Math.ceil((bounds.max.x + 6) / band); ++k) {
     const tile = new THREE.Mesh(geometry, ((k % 2) + 2) % 2 === 0 ? light : dark);
-    tile.position.set((k + 0.5) * band, 0, floorZ - 0.005);
+    tile.position.set((k + 0.5) * band, 0.5 * (trackY0 + trackY1), floorZ - 0.005);
     tile.receiveShadow = true;
     scene.add(tile);
   }
@@ -241,7 +331,7 @@ const center = bounds.getCenter(new THREE.Vector3());
     texture.colorSpace = THREE.SRGBColorSpace;
     const mark = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthWrite: false }));
     mark.scale.set(0.32, 0.16, 1);
-    mark.position.set(x, 1.25, floorZ + 0.08);
+    mark.position.set(x, trackY1 + 0.25, floorZ + 0.08);
     scene.add(mark);
   }
 }
@@ -343,12 +433,27 @@ const camera = new THREE.PerspectiveCamera(30, 1, 0.1, 150);
 camera.up.set(0, 0, 1);
 const target = center.clone();
 
-// Seen from the character's right (-y), a little ahead and above: a side view that keeps
-// a sense of depth. The distance fits the whole box in view (as fit_side_camera does).
+// Whether every view follows its own character (a walker); on at first when the run's
+// characters travel far (data.view.follow, the film strip's choice).
+let following = Boolean(view.follow);
+
+// A planar character is seen from its right (-y), a little ahead and above: a side view
+// that keeps a sense of depth. A 3D character is seen three-quarters, from its right and
+// front and from above (data.view: MuJoCo's azimuth and elevation, as the film strips).
+// The distance fits the whole box in view (as fit_side_camera does); a camera that follows
+// fits the poses relative to their anchors and moves with them.
 function sideView(aspect) {
-  const az = THREE.MathUtils.degToRad(18);
-  const el = THREE.MathUtils.degToRad(10);
-  const back = new THREE.Vector3(Math.sin(az) * Math.cos(el), -Math.cos(az) * Math.cos(el), Math.sin(el));
+  let back;
+  if (view.three_quarter) {
+    const az = THREE.MathUtils.degToRad(view.azimuth);
+    const el = THREE.MathUtils.degToRad(view.elevation);
+    back = new THREE.Vector3(-Math.cos(el) * Math.cos(az), -Math.cos(el) * Math.sin(az), -Math.sin(el));
+  } else {
+    const az = THREE.MathUtils.degToRad(18);
+    const el = THREE.MathUtils.degToRad(10);
+    back = new THREE.Vector3(Math.sin(az) * Math.cos(el), -Math.cos(az) * Math.cos(el), Math.sin(el));
+  }
+  const viewBounds = following ? followBounds : globalViewBounds;
   const forward = back.clone().negate();
   const right = new THREE.Vector3().crossVectors(forward, camera.up).normalize();
   const up = new THREE.Vector3().crossVectors(right, forward).normalize();
@@ -484,6 +589,13 @@ $('time').addEventListener('input', () => {
 });
 $('half').addEventListener('change', () => { last = performance.now(); });
 $('reset-view').addEventListener('click', () => { sideView(aspect()); requestRender(); });
+$('reset-view').textContent = view.three_quarter ? 'Three-quarter view' : 'Side view';
+$('follow').checked = following;
+$('follow').addEventListener('change', () => {
+  following = $('follow').checked;
+  sideView(aspect());
+  requestRender();
+});
 document.addEventListener('keydown', (e) => {
   if (e.code === 'Space' && e.target === document.body) { e.preventDefault(); $('play').click(); }
 });
@@ -524,6 +636,9 @@ function draw() {
 
     for (const r of rigs.values()) r.root.visible = false;
     const track = shownTrack(t);
+    // Following: the shared camera moved, for this view only, to the character's anchor.
+    const shift = following ? anchorAt(track, time) : null;
+    if (shift) { camera.position.add(shift); camera.updateMatrixWorld(); }
     const main = rig(track.model);
     pose(main, track, time);
     main.root.visible = true;
@@ -534,6 +649,7 @@ function draw() {
       ghost.root.visible = true;
     }
     renderer.render(scene, camera);
+    if (shift) { camera.position.sub(shift); camera.updateMatrixWorld(); }
   }
 }
 
@@ -561,6 +677,7 @@ function frame(now) {
 
 fillHeader();
 fillDistances();
+fillPlots(data, $);
 $('play').textContent = playing ? 'Pause' : 'Play';
 new ResizeObserver(requestRender).observe($('stage'));
 window.addEventListener('scroll', requestRender, { passive: true });

@@ -8,8 +8,15 @@
 // change the picture; infeasible path points are marked; the first BVH file loads with
 // three.js's BVHLoader with one joint per moving body and one frame per 1/30 s of motion,
 // and its forward kinematics (as three.js plays it) puts every joint within 1 mm of the
-// body's position in the page's data (MuJoCo's xpos). Writes RUN_DIR/gallery-screenshot.png.
-// Chromium: $CHROMIUM or /usr/bin/chromium.
+// body's position in the page's data (MuJoCo's xpos). The plots panel draws D and the best
+// set's D with one point per generation of the data, C and dmin for every motion, one
+// heatmap per metric with a cell per pair. A 3D run (free root) is seen three-quarters and
+// its "follow" switch moves the views. Where RUN_DIR/export holds glTF files: every .glb
+// passes the Khronos glTF validator with no error, three.js's GLTFLoader reads each with a
+// node per body and its animation, and playing it puts every body within 1 mm of MuJoCo's
+// positions; all.glb is drawn in Chromium by a small three.js viewer (its pixels are not
+// uniform). Writes RUN_DIR/gallery-screenshot.png, plots-screenshot.png and
+// gltf-screenshot.png. Chromium: $CHROMIUM or /usr/bin/chromium.
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -17,6 +24,11 @@ import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
 import * as THREE from 'three';
 import { BVHLoader } from 'three/examples/jsm/loaders/BVHLoader.js';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { existsSync, readdirSync, writeFileSync } from 'node:fs';
+import { dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import validator from 'gltf-validator';
 
 const runDir = resolve(process.argv[2] ?? '');
 if (!process.argv[2]) {
@@ -121,11 +133,12 @@ try {
   const middle = await snapshot();
   check(middle.changed > 2000, 'moving the time scrubber changes the picture', `${middle.changed} pixels changed`);
   const clock = await page.textContent('#clock');
-  check(/^0\.\d\d s \/ \d+\.\d\d s$/.test(clock) && !clock.startsWith('0.00'), 'the clock shows the scrubbed time', clock);
+  const [shown, total] = (clock.match(/^(\d+\.\d\d) s \/ (\d+\.\d\d) s$/) || []).slice(1).map(Number);
+  check(total > 0 && Math.abs(shown - 0.45 * total) <= 0.011, 'the clock shows the scrubbed time (45 %)', clock);
 
   // A path slider: from the result (100 %) to a point whose motion differs from it.
   const v = data.paths.findIndex((p) => p && p.points.length > 1);
-  check(v > 0, 'the page has an optimization path with several points');
+  if (data.paths.length > 0) check(v > 0, 'the page has an optimization path with several points');
   if (v > 0) {
     const points = data.paths[v].points;
     const last = points[points.length - 1];
@@ -152,6 +165,58 @@ try {
     }
     check(marks === points.length, 'infeasible path points are marked (C > 0)', `${marks} of ${points.length}`);
     await slider.fill(String(points.length - 1));
+  }
+
+  // ---------------------------------------------------------------- 3D: the view
+
+  const three = Boolean(data.view && data.view.three_quarter);
+  check((await page.textContent('#reset-view')).trim() === (three ? 'Three-quarter view' : 'Side view'),
+    `the view button names the ${three ? 'three-quarter' : 'side'} view`);
+  const following = await page.locator('#follow').isChecked();
+  check(following === Boolean(data.view && data.view.follow), `"follow" starts ${following ? 'on (the characters travel far)' : 'off'}`);
+  if (three) {
+    await page.locator('#time').fill('700');
+    await settle();
+    await snapshot();
+    await page.locator('#follow').setChecked(!following);
+    await settle();
+    const switched = await snapshot();
+    check(switched.changed > 500, 'switching "follow" moves the views', `${switched.changed} pixels changed`);
+    await page.locator('#follow').setChecked(following);
+  }
+
+  // ---------------------------------------------------------------- the plots panel
+
+  const plots = await page.evaluate(() => {
+    const series = (id) => [...document.querySelectorAll(`#${id} path.series`)].map((p) => ({
+      name: p.dataset.series, points: Number(p.dataset.points), d: p.getAttribute('d') }));
+    return {
+      d: series('plot-d'), c: series('plot-c'), dmin: series('plot-dmin'),
+      heatmaps: [...document.querySelectorAll('#heatmaps .heatmap-box')].map((b) => ({
+        metric: b.dataset.metric, cells: b.querySelectorAll('rect.cell').length })),
+      progressHidden: document.getElementById('progress-panel').hidden,
+    };
+  });
+  const progress = data.progress || {};
+  const n = data.motions.length;
+  if ((progress.generation || []).length > 0) {
+    const g = progress.generation.length;
+    check(plots.d.length === 2 && plots.d.every((p) => p.points === g && (p.d.match(/[ML]/g) || []).length === g),
+      'the plots draw D and the best set\'s D at every generation', JSON.stringify(plots.d.map((p) => [p.name, p.points])));
+    check(plots.c.length === n - 1 && plots.dmin.length === n,
+      'the plots draw C of every variation and dmin of every motion', `${plots.c.length} C, ${plots.dmin.length} dmin`);
+    const last = progress.best_D[g - 1];
+    check(Math.abs(last - data.run.D) <= 1e-9 * Math.max(1, Math.abs(data.run.D)),
+      'the best set\'s D at the last generation is the run\'s D', `${last} vs ${data.run.D}`);
+  } else {
+    check(plots.progressHidden, 'a run without log.jsonl hides the progress plots');
+  }
+  const metrics = ['hf', 'md', 'wja', 'shape'].filter((k) => Array.isArray(data.distances?.[k]) &&
+    (k !== 'shape' || data.distances[k].some((row) => row.some((x) => x > 0))));
+  check(plots.heatmaps.length === metrics.length && plots.heatmaps.every((h) => h.cells === n * n),
+    'one distance heatmap per metric, one cell per pair', JSON.stringify(plots.heatmaps));
+  if (!plots.progressHidden) {
+    await page.locator('#plots').screenshot({ path: join(runDir, 'plots-screenshot.png') });
   }
 
   await page.locator('#time').fill('500');
@@ -195,6 +260,75 @@ try {
     });
   }
   check(worst < 1e-3, 'BVHLoader: joints within 1 mm of MuJoCo\'s body positions', `worst ${(worst * 1000).toFixed(3)} mm`);
+
+  // ---------------------------------------------------------------- glTF
+
+  const exportDir = join(runDir, 'export');
+  const glbs = existsSync(exportDir) ? readdirSync(exportDir).filter((f) => f.endsWith('.glb')).sort() : [];
+  if (glbs.length > 0) {
+    check(glbs.length === data.motions.length + 1, 'one .glb per motion and all.glb', glbs.join(' '));
+    for (const file of glbs) {
+      const bytes = new Uint8Array(readFileSync(join(exportDir, file)));
+      const report = await validator.validateBytes(bytes);
+      const errors = report.issues.messages.filter((m) => m.severity === 0);
+      const warnings = report.issues.messages.filter((m) => m.severity === 1);
+      check(report.issues.numErrors === 0 && warnings.length === 0, `glTF validator: ${file} has no errors or warnings`,
+        [...errors, ...warnings].slice(0, 5).map((m) => `${m.code} ${m.pointer || ''} ${m.message}`).join(' | '));
+    }
+    // Each motion's file in three.js: a node per body, its animation played back against
+    // MuJoCo's body positions (glTF axes: (x, z, -y) of MuJoCo's).
+    let worstGltf = 0;
+    for (const [i, motion] of data.motions.entries()) {
+      const bytes = readFileSync(join(exportDir, `m${i}.glb`));
+      const gltf = await new Promise((ok, fail) => new GLTFLoader().parse(
+        bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength), '', ok, fail));
+      const model = data.models[motion.model];
+      const byName = new Map();
+      gltf.scene.traverse((o) => { if (o.name) byName.set(o.name, o); });
+      const missing = model.bodies.filter((b) => !byName.has(b.name.replace(/[.\s]/g, '_')) && !byName.has(b.name));
+      check(missing.length === 0, `GLTFLoader: ${motion.label} has a node per body`, missing.map((b) => b.name).join(' '));
+      check(gltf.animations.length === 1, `GLTFLoader: ${motion.label} has its animation`);
+      const mixer = new THREE.AnimationMixer(gltf.scene);
+      const clip = gltf.animations[0];
+      mixer.clipAction(clip).setLoop(THREE.LoopOnce, 1).play().clampWhenFinished = true;
+      const count = motion.frames.count;
+      for (const k of [0, Math.floor(count / 2), count - 1]) {
+        mixer.setTime(k / data.fps);
+        gltf.scene.updateMatrixWorld(true);
+        model.bodies.forEach((body, b) => {
+          const node = byName.get(body.name) || byName.get(body.name.replace(/[.\s]/g, '_'));
+          if (!node) return;
+          const p = new THREE.Vector3().setFromMatrixPosition(node.matrixWorld);
+          const o = (k * motion.frames.bodies + b) * 7;
+          const d = motion.frames.data;
+          worstGltf = Math.max(worstGltf, p.distanceTo(new THREE.Vector3(d[o], d[o + 2], -d[o + 1])));
+        });
+      }
+    }
+    check(worstGltf < 1e-3, 'GLTFLoader: bodies within 1 mm of MuJoCo\'s positions', `worst ${(worstGltf * 1000).toFixed(3)} mm`);
+
+    // all.glb in a small three.js viewer page, in Chromium.
+    const here = dirname(fileURLToPath(import.meta.url));
+    const { build } = await import('esbuild');
+    const bundle = await build({ entryPoints: [join(here, 'gltf-view.js')], bundle: true, format: 'iife', write: false, logLevel: 'warning' });
+    const glb = readFileSync(join(exportDir, 'all.glb')).toString('base64');
+    const html = `<!doctype html><html><head><meta charset="utf-8"><title>all.glb</title></head>
+<body style="margin:0"><canvas id="view" width="1200" height="700"></canvas>
+<script type="text/plain" id="glb">${glb}</script>
+<script>${bundle.outputFiles[0].text.replace(/<\/script/gi, '<\\/script')}</script></body></html>`;
+    const viewer = join(runDir, 'gltf-view.html');
+    writeFileSync(viewer, html);
+    const vpage = await context.newPage();
+    const viewErrors = [];
+    vpage.on('pageerror', (e) => viewErrors.push(e.message));
+    vpage.on('console', (m) => { if (m.type() === 'error') viewErrors.push(m.text()); });
+    await vpage.goto(pathToFileURL(viewer).href);
+    await vpage.waitForSelector('body[data-ready="1"]', { timeout: 30000 });
+    const drawn = await vpage.evaluate(() => window.__gltfStats);
+    check(drawn.meshes > 0 && drawn.colours > 100, 'all.glb draws in Chromium with three.js', JSON.stringify(drawn));
+    check(viewErrors.length === 0, 'the glTF viewer logs no errors', viewErrors.join(' | '));
+    await vpage.screenshot({ path: join(runDir, 'gltf-screenshot.png') });
+  }
 } finally {
   await context.close();
   rmSync(userDataDir, { recursive: true, force: true });
