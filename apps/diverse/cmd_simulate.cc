@@ -69,12 +69,23 @@ void run(const SimulateArgs& args) {
     }
   }
   const MotionSummary& s = e.summary;
-  std::printf("peak COM %.3f m, feet touch down at x %.3f y %.3f z %.3f m and end at x %.3f y %.3f z %.3f m, "
-              "rotation %.1f deg (flight %.1f), largest forward pitch %.1f deg, min obstacle distance %.3f m, "
-              "%d steps, %.3f s\n",
-              s.peak_com_z, s.touchdown_feet_x, s.touchdown_feet_y, s.touchdown_feet_z, s.feet_x, s.feet_y,
-              s.feet_z, s.rotation_total * 180 / M_PI, s.rotation_flight * 180 / M_PI,
-              s.max_forward_pitch * 180 / M_PI, s.min_clearance, e.stats.steps, e.stats.time);
+  if (ev.task().walk.enabled) {
+    // A walk: every step's length in the heading frame and the largest tilt before it.
+    for (size_t i = 0; i < s.walk.steps.size(); ++i) {
+      const WalkStep& w = s.walk.steps[i];
+      std::printf("  step %2zu %s at %7.3f s: forward %6.3f m, lateral %6.3f m, heading %6.1f deg, tilt %5.1f deg%s\n",
+                  i + 1, w.leg == 0 ? "left " : "right", w.time, w.forward, w.lateral, w.heading * 180 / M_PI,
+                  w.tilt * 180 / M_PI, static_cast<int>(i) >= ev.task().walk.settle_steps ? "" : "  (settling)");
+    }
+    std::printf("%zu steps, %d simulation steps, %.3f s\n", s.walk.steps.size(), e.stats.steps, e.stats.time);
+  } else {
+    std::printf("peak COM %.3f m, feet touch down at x %.3f y %.3f z %.3f m and end at x %.3f y %.3f z %.3f m, "
+                "rotation %.1f deg (flight %.1f), largest forward pitch %.1f deg, min obstacle distance %.3f m, "
+                "%d steps, %.3f s\n",
+                s.peak_com_z, s.touchdown_feet_x, s.touchdown_feet_y, s.touchdown_feet_z, s.feet_x, s.feet_y,
+                s.feet_z, s.rotation_total * 180 / M_PI, s.rotation_flight * 180 / M_PI,
+                s.max_forward_pitch * 180 / M_PI, s.min_clearance, e.stats.steps, e.stats.time);
+  }
 
   if (!args.no_film) {
     const auto model = SharedModel::from_file((dir / "model.xml").string());

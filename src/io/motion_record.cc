@@ -24,7 +24,7 @@ nlohmann::json rows(const std::vector<double>& flat, int width) {
 }
 
 nlohmann::json summary_json(const MotionSummary& s) {
-  return {{"unstable", s.unstable},           {"took_off", s.took_off},
+  nlohmann::json j = {{"unstable", s.unstable},           {"took_off", s.took_off},
           {"landed", s.landed},               {"settled", s.settled},
           {"fell", s.fell},                   {"fall_reason", s.fall_reason},
           {"peak_com_z", s.peak_com_z},       {"feet_x", s.feet_x},
@@ -34,6 +34,17 @@ nlohmann::json summary_json(const MotionSummary& s) {
           {"max_forward_pitch", s.max_forward_pitch},
           {"rotation_flight", s.rotation_flight}, {"min_clearance", s.min_clearance},
           {"end_time", s.end_time}};
+  if (!s.walk.steps.empty()) {
+    // A walk's steps (task/walk_task.h): leg 0 left, 1 right; lengths in m in the heading
+    // frame at the touch-down; heading and tilt in rad.
+    nlohmann::json steps = nlohmann::json::array();
+    for (const WalkStep& w : s.walk.steps) {
+      steps.push_back({{"leg", w.leg}, {"time", w.time}, {"forward", w.forward}, {"lateral", w.lateral},
+                       {"heading", w.heading}, {"tilt", w.tilt}});
+    }
+    j["walk_steps"] = steps;
+  }
+  return j;
 }
 
 }  // namespace

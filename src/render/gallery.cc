@@ -373,6 +373,14 @@ nlohmann::json shape_data(const nlohmann::json& summary) {
 
 fs::path gallery_template_path() {
   const char* env = std::getenv("DIVERSE_GALLERY_TEMPLATE");
+  // An installed program (`cmake --install`) uses the template installed with it, in
+  // PREFIX/share/diverse beside its bin/, whether or not its build tree is still there.
+  if (!(env && *env)) {
+    std::error_code error;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "diverse" / "gallery-template.html";
+    if (!error && fs::exists(installed)) return installed;
+  }
   const fs::path path = env && *env ? fs::path(env) : fs::path(DIVERSE_GALLERY_TEMPLATE);
   if (!path.empty() && fs::exists(path)) return path;
   const std::string where = path.empty() ? "(no path configured)" : path.string();

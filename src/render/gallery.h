@@ -51,8 +51,9 @@ struct GalleryOptions {
   std::filesystem::path page_template;  // "" = gallery_template_path()
 };
 
-// The page template built from web/ (its path is fixed at build time; the environment
-// variable DIVERSE_GALLERY_TEMPLATE overrides it). Throws UserError saying what is missing
+// The page template built from web/: the environment variable DIVERSE_GALLERY_TEMPLATE if
+// set; else, for an installed program, PREFIX/share/diverse/gallery-template.html beside
+// its bin/; else the path fixed at build time. Throws UserError saying what is missing
 // (node and npm, or `npm ci` in web/) if it does not exist.
 std::filesystem::path gallery_template_path();
 

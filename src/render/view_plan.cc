@@ -74,13 +74,15 @@ ViewPlan plan_view(std::span<const PosedModel> motions) {
       for (int i = 0; i < 2; ++i) lo[i] = std::min(lo[i], p[static_cast<std::size_t>(i)]), hi[i] = std::max(hi[i], p[static_cast<std::size_t>(i)]);
     if (std::hypot(hi[0] - lo[0], hi[1] - lo[1]) > kFollowDistance) plan.follow = true;
     if (!heading) {
+      const auto& x = track.x_axis.front();
       const auto& a = track.position.front();
       const auto& b = track.position.back();
-      if (std::hypot(b[0] - a[0], b[1] - a[1]) > kTravelForHeading) {
+      if (std::hypot(x[0], x[1]) > 0.5) {
+        heading = std::atan2(x[1], x[0]) / kDegree;
+      } else if (std::hypot(b[0] - a[0], b[1] - a[1]) > kTravelForHeading) {
         heading = std::atan2(b[1] - a[1], b[0] - a[0]) / kDegree;
       } else {
-        const auto& x = track.x_axis.front();
-        heading = std::hypot(x[0], x[1]) > 1e-6 ? std::atan2(x[1], x[0]) / kDegree : 0.0;
+        heading = 0.0;
       }
     }
   }

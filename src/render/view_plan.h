@@ -8,10 +8,11 @@
 //   character with a free root (the 3D human, the bird robot) is seen three-quarters: from
 //   its right and kThreeQuarterTurn degrees toward its front, and from kThreeQuarterElevation
 //   degrees above, so both the direction it moves in and the width of its body (arms out,
-//   legs apart, a lean to one side) show. Its front is the direction the first motion
-//   travels (the root's horizontal displacement from first to last frame) when it travels
-//   more than kTravelForHeading; otherwise where its root faces (the root body's x axis) in
-//   the first frame.
+//   legs apart, a lean to one side) show. Its front is where its root faces (the root
+//   body's x axis, the characters' forward) in the first motion's first frame, so a jump
+//   backwards is seen from the front as well, travelling away to the side; a root whose x
+//   axis points up or down there takes the direction the motion travels (from first to
+//   last frame, if more than kTravelForHeading), else +x.
 // - Following. When any motion's root travels more than kFollowDistance horizontally (a
 //   walk of 15 m, a long jump), one camera fitted to everything would show the character
 //   a few pixels tall. Then every picture is centred on its own character instead: the

@@ -6,6 +6,7 @@
 namespace diverse {
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
+  if (task.walk.enabled) return walk_constraints(task, motion);
   const TaskConstraints& c = task.constraints;
   ConstraintReport report;
   auto add = [&](const char* name, double violation, double penalty) {
@@ -71,6 +72,7 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
 }
 
 double constraint_margin(const Task& task, const MotionSummary& motion) {
+  if (task.walk.enabled) return walk_margin(task, motion);
   const TaskConstraints& c = task.constraints;
   double margin = 1.0;  // m; no constraint is looser than this counts
   if (c.landing && c.landing_radius > 0) {

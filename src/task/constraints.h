@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "task/task.h"
+#include "task/walk_task.h"
 
 namespace diverse {
 
@@ -41,6 +42,7 @@ struct MotionSummary {
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
+  WalkSummary walk;           // a walk task's steps (task/walk_task.h)
 };
 
 struct ConstraintTerm {

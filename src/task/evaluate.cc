@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "task/walk_eval.h"
 
 namespace diverse {
 namespace {
@@ -282,6 +283,8 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
   mjModel* m = worker.model();
   const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
   JointDrive drive = make_drive(body);
+  controller->start_state(m, worker.data());
+  if (task_.walk.enabled) return evaluate_walk(*controller, drive, body, worker, options);
   e.flight_time.reserve(1024);
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
   JumpHooks hooks(task_, body, *controller, drive, obstacle_geom_, e);
@@ -306,6 +309,26 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
       e.poses.insert(e.poses.end(), poses.begin(), poses.end());
     }
   }
+  return e;
+}
+
+Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& drive, const Character& body,
+                                        SimWorker& worker, const EvaluationOptions& options) const {
+  Evaluation e;
+  mjModel* m = worker.model();
+  WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, e);
+  const int max_steps = static_cast<int>(std::ceil(task_.walk.max_time / m->opt.timestep)) + 1;
+  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  e.phases = controller.phase_times();
+  if (e.stats.unstable) {
+    e.failed = true;
+    e.failure = "simulation unstable: " + e.stats.instability;
+    e.summary.unstable = true;
+  }
+  e.report = evaluate_constraints(task_, e.summary);
+  e.constraint = e.report.total;
+  e.fell = e.report.fell;
+  if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);
   return e;
 }
 

@@ -45,7 +45,7 @@ struct PoseSample {
 };
 
 struct EvaluationOptions {
-  int samples_per_phase = 10;        // poses per airborne phase at (k + 0.5) / n; 0 = none
+  int samples_per_phase = 10;        // poses per airborne phase (a walk: per state) at (k + 0.5) / n; 0 = none
   StepRecorder* recorder = nullptr;  // exact-replay record (off in the optimizer)
 };
 
@@ -160,6 +160,9 @@ class TaskEvaluator {
   std::vector<ParamSpec> specs_;  // the controller's parameters for body_, named once
   int obstacle_geom_ = -1;
 
+  // The rollout of a walk task (task/walk_eval.h), from the controller's start state.
+  Evaluation evaluate_walk(Controller& controller, JointDrive& drive, const Character& body,
+                           SimWorker& worker, const EvaluationOptions& options) const;
   // The rollout of evaluate(), on `body` (the task's, or a shaped scene's).
   Evaluation evaluate_on(const std::vector<double>& values, const Character& body,
                          SimWorker& worker, const EvaluationOptions& options) const;

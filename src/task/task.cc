@@ -224,7 +224,7 @@ Task load_task(const std::string& path) {
   task.file = path;
   TomlReader r(path, root, "");
   r.only({"name", "description", "character", "metric", "variations", "m0", "controller",
-          "simulation", "objects", "constraints", "seed", "diversity"});
+          "simulation", "objects", "constraints", "seed", "diversity", "walk"});
   task.name = r.string("name");
   if (task.name.empty()) r.fail("name", "expected a non-empty string");
   task.description = r.string("description", "");
@@ -243,6 +243,12 @@ Task load_task(const std::string& path) {
   read_constraints(r.sub("constraints", *r.table("constraints", true)), task);
   if (auto t = r.table("seed", false)) read_seed(r.sub("seed", *t), task);
   if (auto t = r.table("diversity", false)) read_diversity(r.sub("diversity", *t), task);
+  if (auto t = r.table("walk", false)) read_walk(r.sub("walk", *t), task.walk);
+  const bool walks = std::string(task.controller_type->skill()) == "walk";
+  if (walks != task.walk.enabled) {
+    r.fail("walk", walks ? "expected a [walk] table for the walk controller \"" + task.controller + "\" (missing)"
+                         : "expected no [walk] table: the controller \"" + task.controller + "\" does not walk");
+  }
   return task;
 }
 

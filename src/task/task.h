@@ -21,6 +21,7 @@
 
 #include "character/character.h"
 #include "control/controller.h"
+#include "task/walk_task.h"
 
 namespace diverse {
 
@@ -125,6 +126,7 @@ struct Task {
   std::string m0;           // resolved path of M0's parameters (need not exist yet)
   TaskSeed seed;
   TaskDiversity diversity;
+  TaskWalk walk;            // [walk]: a walk task (task/walk_task.h)
 
   const SceneObject* find_object(const std::string& name) const;
 };

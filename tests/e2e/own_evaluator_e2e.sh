@@ -17,6 +17,18 @@ for f in lib/libdiverse_core.a include/diverse/optimize/diversity.h include/dive
   [ -e "$work/prefix/$f" ] || { echo "FAIL - installed $f"; exit 1; }
 done
 echo "ok - cmake --install writes the library, its headers, the package config and the tool"
+if [ -f "$build/web/gallery-template.html" ]; then
+  # The installed tool uses the page installed beside it: marked here, it shows in a gallery.
+  page="$work/prefix/share/diverse/gallery-template.html"
+  [ -f "$page" ] || { echo "FAIL - installed the gallery page"; exit 1; }
+  echo "<!-- the installed page -->" >>"$page"
+  "$work/prefix/bin/diverse" run "$src/tasks/jump_high.toml" --n 1 --generations 1 --popsize 4 --seed 2 \
+    --quiet --no-render --out "$work/run" >/dev/null
+  DIVERSE_GALLERY_TEMPLATE= "$work/prefix/bin/diverse" gallery "$work/run" --no-paths >/dev/null
+  grep -q "<!-- the installed page -->" "$work/run/gallery.html" ||
+    { echo "FAIL - the installed tool's gallery uses the installed page"; exit 1; }
+  echo "ok - the installed tool makes galleries with the page installed beside it"
+fi
 cmake -S "$src/examples/own-evaluator" -B "$work/swing" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
 cmake --build "$work/swing" -j2 >/dev/null

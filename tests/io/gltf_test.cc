@@ -2,12 +2,14 @@
 // bodies are, each with a mesh of its geoms in the model's colours; and its animation,
 // evaluated at every keyframe and composed down the node tree, puts every body where MuJoCo
 // does (position and orientation, in glTF's Y-up axes), for the 3D human pushed sideways,
-// the bird robot and the planar human. Several motions side by side keep their own bodies.
+// the bird robot and the planar human. Several motions side by side keep their own bodies,
+// and a shaped body (longer thighs) its own proportions.
 #include "io/gltf.h"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -15,6 +17,8 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "character/character.h"
+#include "character/shape.h"
 #include "physics/model.h"
 #include "support/stance_run.h"
 
@@ -207,6 +211,46 @@ TEST(GltfExport, PlanarHumanMatchesMujoco) {
   const fs::path file = temp_dir() / "human2d.glb";
   write_glb(file, {GltfMotion{m, frames, "M0", {0, 0, 0}}});
   expect_matches_mujoco(m, frames, read_glb(file), "");
+}
+
+// A run whose bodies varied exports each body with its own proportions: the planar human
+// with thighs 1.5 times as long has a thigh mesh longer by half a thigh, and its bodies are
+// where MuJoCo puts them on the shaped model.
+TEST(GltfExport, ShapedBodiesKeepTheirProportions) {
+  const std::string root = DIVERSE_SOURCE_DIR;
+  const auto spec = std::make_shared<CharacterSpec>(load_character_file(root + "/assets/characters/human2d.toml"));
+  const auto base = SharedModel::from_file(spec->model);
+  const ShapeSpace shapes(base->xml(), *spec);
+  Eigen::VectorXd scales = shapes.identity();
+  int thigh = -1;
+  for (int p = 0; p < shapes.size(); ++p)
+    if (shapes.specs()[static_cast<std::size_t>(p)].name == "shape.thigh") thigh = p;
+  ASSERT_GE(thigh, 0);
+  scales[thigh] = 1.5;
+  const auto shaped = shapes.compile(scales);
+  const mjModel* mb = base->get();
+  const mjModel* ms = shaped->get();
+  const std::vector<std::vector<double>> fb{std::vector<double>(mb->qpos0, mb->qpos0 + mb->nq)};
+  const std::vector<std::vector<double>> fs{std::vector<double>(ms->qpos0, ms->qpos0 + ms->nq)};
+  const fs::path file = temp_dir() / "shaped.glb";
+  write_glb(file, {GltfMotion{mb, fb, "M0", {0, 0, 0}}, GltfMotion{ms, fs, "M1", {0, 0, 0}}});
+  const tinygltf::Model g = read_glb(file);
+  auto thigh_extent = [&](const std::string& node_name) {
+    for (const auto& node : g.nodes) {
+      if (node.name != node_name) continue;
+      const auto& prim = g.meshes[static_cast<std::size_t>(node.mesh)].primitives[0];
+      const auto& a = g.accessors[static_cast<std::size_t>(prim.attributes.at("POSITION"))];
+      return a.maxValues[1] - a.minValues[1];  // glTF y: along the hanging thigh
+    }
+    ADD_FAILURE() << node_name << " not found";
+    return 0.0;
+  };
+  const int link = static_cast<int>(std::find(shapes.link_names().begin(), shapes.link_names().end(), "thigh_l") -
+                                    shapes.link_names().begin());
+  ASSERT_LT(link, static_cast<int>(shapes.link_names().size()));
+  const double length = shapes.base_link_lengths()[link];
+  EXPECT_NEAR(thigh_extent("M1 thigh_l") - thigh_extent("M0 thigh_l"), 0.5 * length, 1e-4);
+  expect_matches_mujoco(ms, fs, g, "M1 ");
 }
 
 TEST(GltfExport, BadInput) {

@@ -59,7 +59,7 @@ TEST(ViewPlan, PlanarCharactersAreSeenFromTheSide) {
   EXPECT_EQ(plan.direction.elevation, SideCamera{}.elevation);
 }
 
-TEST(ViewPlan, FreeRootsAreSeenThreeQuartersFacingWhereTheyGo) {
+TEST(ViewPlan, FreeRootsAreSeenThreeQuartersFromTheirFront) {
   const auto model = character("human3d");
   EXPECT_TRUE(has_free_root(model->get()));
   EXPECT_EQ(root_body(model->get()), mj_name2id(model->get(), mjOBJ_BODY, "pelvis"));
@@ -71,12 +71,29 @@ TEST(ViewPlan, FreeRootsAreSeenThreeQuartersFacingWhereTheyGo) {
   EXPECT_NEAR(stand.direction.azimuth, 90.0 + kThreeQuarterTurn, 1e-9);
   EXPECT_NEAR(stand.direction.elevation, kThreeQuarterElevation, 1e-9);
   EXPECT_FALSE(stand.follow);
-  // Travelling 1.9 m along +y: the front is +y, whatever the root faces.
+  // Travelling 1.9 m along -x (a jump backwards) or along +y: the front is still where the
+  // root faces.
+  const auto back = glide(model->get(), -0.1, 0.0, 20);
+  EXPECT_NEAR(plan_view(std::vector<PosedModel>{{model->get(), back}}).heading, 0.0, 1e-9);
   const auto sideways = glide(model->get(), 0.0, 0.1, 20);
-  const ViewPlan plan = plan_view(std::vector<PosedModel>{{model->get(), sideways}});
+  EXPECT_NEAR(plan_view(std::vector<PosedModel>{{model->get(), sideways}}).heading, 0.0, 1e-9);
+  // A root turned 90 degrees to the left (about z) faces +y.
+  auto turned = still;
+  for (auto& q : turned) {
+    q[3] = std::cos(M_PI / 4);
+    q[6] = std::sin(M_PI / 4);
+  }
+  const ViewPlan plan = plan_view(std::vector<PosedModel>{{model->get(), turned}});
   EXPECT_NEAR(plan.heading, 90.0, 1e-9);
   EXPECT_NEAR(plan.direction.azimuth, 180.0 + kThreeQuarterTurn, 1e-9);
   EXPECT_FALSE(plan.follow);
+  // Lying on its back (root x axis straight up) and travelling along +y: the travel decides.
+  auto lying = sideways;
+  for (auto& q : lying) {
+    q[3] = std::cos(-M_PI / 4);
+    q[5] = std::sin(-M_PI / 4);  // -90 degrees about y: x axis to +z
+  }
+  EXPECT_NEAR(plan_view(std::vector<PosedModel>{{model->get(), lying}}).heading, 90.0, 1e-9);
 }
 
 TEST(ViewPlan, CamerasFollowACharacterThatTravelsFar) {

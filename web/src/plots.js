@@ -59,7 +59,7 @@ export function lineChart({ title, xLabel, yLabel, xs, series, scale = 'linear',
   const root = svg('svg', { viewBox: `0 0 ${width} ${height}`, width, height, class: 'chart', role: 'img', 'aria-label': title });
   root.append(svg('text', { x: m.left, y: 16, class: 'chart-title' }, title));
   // Axes and grid.
-  for (const t of ticks(x0, x1, 6)) {
+  for (const t of ticks(x0, x1, 6).filter(Number.isInteger)) {  // generations are whole
     root.append(svg('line', { x1: X(t), x2: X(t), y1: m.top, y2: m.top + h, class: 'grid' }));
     root.append(svg('text', { x: X(t), y: m.top + h + 15, class: 'tick', 'text-anchor': 'middle' }, String(t)));
   }
@@ -155,7 +155,7 @@ export function shapeBars({ names, scales, labels, width = 940, height = 260 }) 
       r.append(svg('title', {}, `${label} ${name}: ${v.toFixed(3)}`));
       root.append(r);
     });
-    root.append(svg('text', { x: m.left + (p + 0.5) * group, y: m.top + h + 14, class: 'tick', 'text-anchor': 'end', transform: `rotate(-30 ${m.left + (p + 0.5) * group} ${m.top + h + 14})` }, name));
+    root.append(svg('text', { x: m.left + (p + 0.5) * group, y: m.top + h + 14, class: 'tick', 'text-anchor': 'end', transform: `rotate(-30 ${m.left + (p + 0.5) * group} ${m.top + h + 14})` }, name.replace(/^shape\./, '')));
   });
   root.append(svg('line', { x1: m.left, x2: m.left + w, y1: Y(1), y2: Y(1), class: 'unit' }));
   root.append(svg('rect', { x: m.left, y: m.top, width: w, height: h, class: 'frame' }));

@@ -211,7 +211,9 @@ try {
   } else {
     check(plots.progressHidden, 'a run without log.jsonl hides the progress plots');
   }
-  const metrics = ['hf', 'md', 'wja', 'shape'].filter((k) => Array.isArray(data.distances?.[k]) &&
+  const objective = data.distances?.objective;
+  const combined = typeof objective === 'string' && objective.endsWith('+shape') ? [objective] : [];
+  const metrics = ['hf', 'md', 'wja', 'shape', ...combined].filter((k) => Array.isArray(data.distances?.[k]) &&
     (k !== 'shape' || data.distances[k].some((row) => row.some((x) => x > 0))));
   check(plots.heatmaps.length === metrics.length && plots.heatmaps.every((h) => h.cells === n * n),
     'one distance heatmap per metric, one cell per pair', JSON.stringify(plots.heatmaps));

@@ -1,0 +1,207 @@
+#include "task/walk_eval.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "control/walk_controller.h"
+
+namespace diverse {
+namespace {
+
+bool is_lift(int state) { return state == kLeftLift || state == kRightLift; }
+
+// World orientation of every body at the model's qpos0 (hinges add no rotation there).
+std::vector<std::array<double, 4>> standing_orientations(const mjModel* m) {
+  std::vector<std::array<double, 4>> q(static_cast<size_t>(m->nbody), {1, 0, 0, 0});
+  for (int b = 1; b < m->nbody; ++b) {
+    mju_mulQuat(q[static_cast<size_t>(b)].data(), q[static_cast<size_t>(m->body_parentid[b])].data(),
+                m->body_quat + 4 * b);
+  }
+  return q;
+}
+
+// World "up" in the frame of a body whose world orientation is q.
+std::array<double, 3> up_in(const std::array<double, 4>& q) {
+  double R[9];
+  mju_quat2Mat(R, q.data());
+  return {R[6], R[7], R[8]};  // R^T z
+}
+
+}  // namespace
+
+WalkObserver::WalkObserver(const Task& task, const Character& body, const mjModel* m,
+                           Controller& controller, JointDrive& drive, int samples, Evaluation& out)
+    : task_(task), body_(body), controller_(controller), drive_(drive), samples_(samples), out_(out) {
+  nq_ = m->nq;
+  const auto standing = standing_orientations(m);
+  root_up_ = up_in(standing[static_cast<size_t>(body.root_body)]);
+  // The torso: the body of the deepest centre waist hinge, if any.
+  size_t depth = 0;
+  for (size_t k = 0; k < body.joints.size(); ++k) {
+    const CharacterJoint& j = body.joints[k];
+    if (body.groups[static_cast<size_t>(j.group)].role != JointRole::kWaist || j.side != Side::kCenter) continue;
+    const size_t dd = body.chain(static_cast<int>(k)).size();
+    if (torso_ < 0 || dd > depth) {
+      torso_ = j.body;
+      depth = dd;
+    }
+  }
+  if (torso_ >= 0) torso_up_ = up_in(standing[static_cast<size_t>(torso_)]);
+  double R[9];
+  mju_quat2Mat(R, standing[static_cast<size_t>(body.root_body)].data());
+  standing_heading_ = std::atan2(R[3], R[0]);
+}
+
+double WalkObserver::heading(const mjData* d) const {
+  const double* R = d->xmat + 9 * body_.root_body;
+  return std::atan2(R[3], R[0]) - standing_heading_;
+}
+
+double WalkObserver::tilt(const mjData* d, int b, const std::array<double, 3>& up) const {
+  const double* R = d->xmat + 9 * b;
+  const double z = R[6] * up[0] + R[7] * up[1] + R[8] * up[2];  // (R up) . world z
+  return std::acos(std::clamp(z, -1.0, 1.0));
+}
+
+void WalkObserver::control(mjModel* m, mjData* d) {
+  contacts_ = scan_contacts(m, d, body_);
+  if (first_) controller_.reset(m, d);
+  controller_.control(m, d, contacts_, drive_);
+}
+
+bool WalkObserver::fall(const mjData* d, const char* why) {
+  MotionSummary& s = out_.summary;
+  s.fell = true;
+  s.fall_reason = why;
+  s.fall_progress = std::min(1.0, static_cast<double>(s.walk.steps.size()) / task_.walk.steps);
+  s.end_time = d->time;
+  return true;
+}
+
+void WalkObserver::close_state(int state) {
+  const size_t n = state_time_.size();
+  if (n == 0 || samples_ <= 0) return;
+  const double a = state_time_.front(), b = state_time_.back();
+  for (int k = 0; k < samples_; ++k) {
+    const double tau = (k + 0.5) / samples_;
+    const double t = a + tau * (b - a);
+    size_t hi = static_cast<size_t>(std::lower_bound(state_time_.begin(), state_time_.end(), t) - state_time_.begin());
+    hi = std::min(hi, n - 1);
+    const size_t lo = hi > 0 ? hi - 1 : 0;
+    const double span = state_time_[hi] - state_time_[lo];
+    const double w = span > 0 ? std::clamp((t - state_time_[lo]) / span, 0.0, 1.0) : 1.0;
+    for (int i = 0; i < nq_; ++i) {
+      sample_qpos_.push_back((1 - w) * state_qpos_[lo * static_cast<size_t>(nq_) + static_cast<size_t>(i)] +
+                             w * state_qpos_[hi * static_cast<size_t>(nq_) + static_cast<size_t>(i)]);
+    }
+    sample_state_.push_back(state);
+    sample_tau_.push_back(tau);
+    sample_time_.push_back(t);
+  }
+}
+
+bool WalkObserver::observe(const mjModel* m, const mjData* d) {
+  MotionSummary& s = out_.summary;
+  WalkSummary& walk = s.walk;
+  const TaskWalk& w = task_.walk;
+  const double t = d->time;
+  // Heading, unwrapped.
+  const double raw = heading(d);
+  if (first_) {
+    heading_ = raw;
+    walk.start_heading = raw;
+    const int stance = 1 - swing_leg(kLeftLift);
+    const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(stance)];
+    last_foot_ = {f[0], f[1]};
+    state_ = controller_.phase();
+    first_ = false;
+  } else {
+    heading_ += std::remainder(raw - last_raw_heading_, 2 * M_PI);
+  }
+  last_raw_heading_ = raw;
+  tilt_ = std::max(tilt_, tilt(d, body_.root_body, root_up_));
+  if (torso_ >= 0) tilt_ = std::max(tilt_, tilt(d, torso_, torso_up_));
+
+  const int state = controller_.phase();
+  bool last_step = false;
+  if (controller_.phase_changed() && state != state_) {
+    const int ended = state_;
+    if (recording_) {
+      state_time_.push_back(t);
+      state_qpos_.insert(state_qpos_.end(), d->qpos, d->qpos + m->nq);
+      close_state(ended);
+    }
+    state_time_.clear();
+    state_qpos_.clear();
+    state_ = state;
+    if (is_lift(state)) {
+      // A strike state ended: a touch-down, or a swing foot that never came down.
+      const int leg = swing_leg(ended);
+      if (!contacts_.foot[static_cast<size_t>(leg)]) return fall(d, "the swing foot did not come down");
+      const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(leg)];
+      const double dx = f[0] - last_foot_[0], dy = f[1] - last_foot_[1];
+      const double h = raw;
+      WalkStep step;
+      step.leg = leg;
+      step.time = t;
+      step.forward = std::cos(h) * dx + std::sin(h) * dy;
+      step.lateral = -std::sin(h) * dx + std::cos(h) * dy;
+      step.heading = heading_;
+      step.tilt = tilt_;
+      walk.steps.push_back(step);
+      tilt_ = 0;
+      last_foot_ = {f[0], f[1]};
+      const int taken = static_cast<int>(walk.steps.size());
+      if (taken >= w.steps) {
+        last_step = true;
+      } else if (state == kLeftLift && taken >= w.settle_steps) {
+        recording_ = true;  // a stride begins after the walk has settled
+      }
+    }
+  }
+  if (last_step) {
+    complete_ = recording_;
+    s.end_time = t;
+    return true;
+  }
+  if (recording_) {
+    state_time_.push_back(t);
+    state_qpos_.insert(state_qpos_.end(), d->qpos, d->qpos + m->nq);
+  }
+
+  // Falls.
+  if (contacts_.non_foot) return fall(d, "a body other than the feet touched the ground or an object");
+  const double feet_z = 0.5 * (d->xipos[3 * body_.feet[0] + 2] + d->xipos[3 * body_.feet[1] + 2]);
+  if (controller_.com()[2] - feet_z < task_.simulation.fall_com_height) {
+    return fall(d, "the centre of mass dropped to the feet");
+  }
+  if (t + m->opt.timestep > w.max_time) return fall(d, "did not take its steps in time");
+  return false;
+}
+
+std::vector<PoseSample> WalkObserver::poses(SimWorker& worker) const {
+  std::vector<PoseSample> out;
+  if (!complete_) return out;
+  const mjModel* m = worker.model();
+  mjData* d = worker.data();
+  for (size_t k = 0; k < sample_state_.size(); ++k) {
+    mju_copy(d->qpos, sample_qpos_.data() + k * static_cast<size_t>(nq_), nq_);
+    mju_normalize4(d->qpos + body_.root_qpos + 3);
+    mj_kinematics(m, d);
+    PoseSample p;
+    p.phase = sample_state_[k];
+    p.phase_time = sample_tau_[k];
+    p.time = sample_time_[k];
+    p.link_com.resize(3, static_cast<int>(body_.links.size()));
+    for (size_t i = 0; i < body_.links.size(); ++i) {
+      for (int c = 0; c < 3; ++c) p.link_com(c, static_cast<int>(i)) = d->xipos[3 * body_.links[i] + c];
+    }
+    p.angles.resize(static_cast<int>(body_.joints.size()));
+    for (size_t i = 0; i < body_.joints.size(); ++i) p.angles[static_cast<int>(i)] = d->qpos[body_.joints[i].qpos];
+    p.root = root_orientation(body_, d->qpos);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace diverse

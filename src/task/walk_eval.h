@@ -1,0 +1,74 @@
+// The rollout observer of a walk task (task/walk_task.h): drives the walk controller,
+// counts steps, measures each step's length in the heading frame and the pelvis and torso
+// tilt, detects falls, and ends the rollout as soon as the outcome is decided (a fall, or
+// the last step's touch-down). TaskEvaluator (task/evaluate.h) uses it for every task
+// with a [walk] table.
+//
+// Pose samples (paper section 4.1): in every evaluated stride (the strides after the
+// first settle_steps steps; a stride is the four states left lift, left strike, right
+// lift, right strike) each state gives `samples` poses at its state-normalized times
+// (k + 0.5) / samples, interpolated between the bracketing simulation steps:
+// 4 * samples * (steps - settle_steps) / 2 poses for a walk that takes all its steps, none
+// otherwise. PoseSample::phase is the state (0 to 3).
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <array>
+#include <vector>
+
+#include "character/character.h"
+#include "control/controller.h"
+#include "physics/drive.h"
+#include "physics/model.h"
+#include "physics/rollout.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+
+namespace diverse {
+
+class WalkObserver : public StepHooks {
+ public:
+  // `m` is the model the rollout runs (standing orientations are read from it); `out`
+  // receives the summary (out.summary: fell, walk steps).
+  WalkObserver(const Task& task, const Character& body, const mjModel* m, Controller& controller,
+               JointDrive& drive, int samples, Evaluation& out);
+
+  void control(mjModel* m, mjData* d) override;
+  bool observe(const mjModel* m, const mjData* d) override;
+
+  // The pose samples of the evaluated strides, after the rollout (uses worker's mjData
+  // as scratch). Empty unless the walk took all its steps.
+  std::vector<PoseSample> poses(SimWorker& worker) const;
+
+ private:
+  bool fall(const mjData* d, const char* why);
+  double heading(const mjData* d) const;  // rad, of the root, relative to standing
+  double tilt(const mjData* d, int body, const std::array<double, 3>& up) const;
+  void close_state(int state);           // samples of the state that just ended
+
+  const Task& task_;
+  const Character& body_;
+  Controller& controller_;
+  JointDrive& drive_;
+  int samples_;
+  Evaluation& out_;
+  ContactState contacts_;
+  bool first_ = true;
+  int torso_ = -1;                     // body tracked for uprightness besides the root, or -1
+  std::array<double, 3> root_up_{0, 0, 1}, torso_up_{0, 0, 1};  // standing "up" in each body's frame
+  double standing_heading_ = 0;
+  double heading_ = 0, last_raw_heading_ = 0;  // unwrapped
+  std::array<double, 2> last_foot_{};   // where the previous stance foot is (m, x y)
+  double tilt_ = 0;                     // rad, largest since the last step
+  int nq_ = 0;
+  // Recording the evaluated strides.
+  bool recording_ = false;
+  bool complete_ = false;
+  int state_ = 0;
+  std::vector<double> state_time_, state_qpos_;   // the current state's steps
+  std::vector<int> sample_state_;                  // per sample: its state
+  std::vector<double> sample_tau_, sample_time_, sample_qpos_;
+};
+
+}  // namespace diverse

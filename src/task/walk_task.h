@@ -1,0 +1,84 @@
+// Walk tasks: what a walk must achieve, what a walk rollout measured, and its constraint
+// penalty (the walk counterpart of task/constraints.h).
+//
+// A task is a walk when its file has a [walk] table (and its controller is a walk
+// controller, ControllerType::skill() == "walk"):
+//
+//   [walk]
+//   steps = 30                  # steps simulated; the rollout ends at the last touch-down
+//   settle_steps = 10           # the first steps let the walk settle; the rest are evaluated
+//   forward = { center = 1.0, half_width = 0.5 }   # m, every evaluated step
+//   lateral = { center = 0.0, half_width = 0.5 }   # m, every evaluated step
+//   max_tilt = 15.0             # degrees from vertical, pelvis and torso, evaluated steps
+//   max_turn = 30.0             # degrees, heading change over the evaluated steps
+//   max_time = 40.0             # s; a walk that has not taken `steps` steps by then fell
+//
+// A step is a touch-down of the swing foot that ends a strike state (the controller's
+// phase changes from a strike state to the next lift state with the swing foot in
+// contact). Its length is where the new stance foot is (its body origin: the human's
+// ankle, the robot's toe joint) minus where the previous stance foot was, in the heading
+// frame at the touch-down: forward along the root's forward axis turned onto the ground,
+// lateral to its left. The first step is measured from the stance foot of the start.
+//
+// Drift and turns. Step lengths are measured in the walker's own heading frame, so a
+// walk that curves gently is judged by its steps, not by where it heads; a walk that
+// sidles steps sideways, which the lateral range catches. The heading may change by at
+// most max_turn degrees between the touch-down that begins the evaluated steps and the
+// last one; beyond that the walk is turning, not walking, and pays K_c d^2 with d the
+// excess in rad.
+//
+// C for a walk: K_c |d|^2 over every evaluated step's forward and lateral excess (m),
+// every pelvis/torso tilt excess (rad, the largest over each evaluated step) and the
+// turn excess (rad); a fall (a body other than the feet touching anything, the COM
+// within fall_com_height of the feet, a strike state that ends without a touch-down, not
+// reaching `steps` steps within max_time) costs fall_penalty * (1 - k / steps) with k the
+// steps taken before it: fall_penalty for a fall in the first step, falling linearly to 0
+// after the last. A rollout whose simulation blew up costs 3 * fall_penalty.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace diverse {
+
+class TomlReader;
+struct Task;
+struct MotionSummary;
+struct ConstraintReport;
+
+struct TaskWalk {
+  bool enabled = false;  // the task file has a [walk] table
+  int steps = 30;
+  int settle_steps = 10;
+  double forward_center = 1.0, forward_half_width = 0.5;  // m
+  double lateral_center = 0.0, lateral_half_width = 0.5;  // m
+  double max_tilt_deg = 15;
+  double max_turn_deg = 30;
+  double max_time = 40;  // s
+};
+
+// Parses a [walk] table into `walk` (enabled). Throws UserError "FILE: walk.KEY: expected ...".
+void read_walk(const TomlReader& r, TaskWalk& walk);
+
+// One step of a walk.
+struct WalkStep {
+  int leg = 0;            // the leg that touched down: 0 left, 1 right
+  double time = 0;        // s
+  double forward = 0;     // m, heading frame at the touch-down
+  double lateral = 0;     // m
+  double heading = 0;     // rad, at the touch-down (unwrapped over the walk)
+  double tilt = 0;        // rad, the largest pelvis or torso tilt since the previous step
+};
+
+struct WalkSummary {
+  std::vector<WalkStep> steps;
+  double start_heading = 0;  // rad
+};
+
+// The walk terms of C (called by evaluate_constraints() for a walk task).
+ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion);
+// The smallest slack (m; tilt and turn count 1 m per rad) over the evaluated steps'
+// ranges, negative when violated; -1 for a fall (called by constraint_margin()).
+double walk_margin(const Task& task, const MotionSummary& motion);
+
+}  // namespace diverse

@@ -1,0 +1,196 @@
+// Walk tasks (task/walk_task.h, task/walk_eval.h): the [walk] table is read strictly and
+// must go with a walk controller; the walk constraint penalty follows the task's ranges,
+// grades a fall by the steps taken and judges turns; evaluating the committed starting
+// walks counts 30 alternating steps and stops at the last touch-down, meets both tasks,
+// and gives 10 pose samples in each of the 4 states of the 10 evaluated strides; a walk
+// that falls ends its rollout at the fall.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+#include "metric/metric.h"
+#include "task/constraints.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+#include "task/walk_task.h"
+
+namespace diverse {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
+
+std::string walk_text() {
+  return "name = \"w\"\n"
+         "character = \"" + std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human3d.toml\"\n"
+         "metric = \"md\"\n"
+         "variations = 4\n"
+         "m0 = \"w.m0.json\"\n"
+         "[controller]\n"
+         "type = \"walk3d\"\n"
+         "[constraints]\n"
+         "weight = 5000.0\n"
+         "fall_penalty = 50000.0\n"
+         "[walk]\n"
+         "steps = 30\n"
+         "settle_steps = 10\n"
+         "forward = { center = 1.0, half_width = 0.5 }\n";
+}
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
+// The error message of loading `text`, without the file name in front.
+std::string error_of(const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / ("diverse_walk_task_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string path = (dir / "w.toml").string();
+  std::ofstream(path) << text;
+  try {
+    load_task(path);
+  } catch (const UserError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.rfind(path, 0), 0u) << message;
+    return message.substr(path.size());
+  }
+  return "(no error)";
+}
+
+TEST(WalkTaskFile, CommittedTasksParse) {
+  const Task human = load_task(kTasks + "silly_walk.toml");
+  EXPECT_TRUE(human.walk.enabled);
+  EXPECT_EQ(human.walk.steps, 30);
+  EXPECT_EQ(human.walk.settle_steps, 10);
+  EXPECT_EQ(human.walk.forward_center, 1.0);
+  EXPECT_EQ(human.walk.forward_half_width, 0.5);
+  EXPECT_EQ(human.walk.lateral_half_width, 0.5);
+  EXPECT_EQ(human.walk.max_tilt_deg, 15);
+  EXPECT_EQ(human.constraints.fall_penalty, 50000);
+  const Task robot = load_task(kTasks + "robot_silly_walk.toml");
+  EXPECT_EQ(robot.walk.forward_center, 1.2);
+  EXPECT_EQ(robot.walk.forward_half_width, 0.3);
+  EXPECT_EQ(robot.walk.lateral_half_width, 0.3);
+  EXPECT_EQ(load_task(kTasks + "jump_high.toml").walk.enabled, false);
+}
+
+TEST(WalkTaskFile, BadInputIsOneLine) {
+  EXPECT_EQ(error_of(walk_text()), "(no error)");
+  auto starts = [](const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; };
+  EXPECT_PRED2(starts, error_of(replace(walk_text(), "steps = 30\n", "strides = 15\n")),
+               ": walk.strides: expected no such key");
+  EXPECT_EQ(error_of(replace(walk_text(), "settle_steps = 10", "settle_steps = 30")),
+            ": walk.settle_steps: expected an integer in [0, 29], got 30");
+  EXPECT_PRED2(starts, error_of(replace(walk_text(), "half_width = 0.5 }", "half = 0.5 }")),
+               ": walk.forward.half: expected no such key");
+  EXPECT_EQ(error_of(replace(walk_text(), "[walk]\nsteps = 30\nsettle_steps = 10\nforward = { center = 1.0, half_width = 0.5 }\n", "")),
+            ": walk: expected a [walk] table for the walk controller \"walk3d\" (missing)");
+  const std::string jump = replace(replace(walk_text(), "human3d.toml", "human2d.toml"), "walk3d", "jump2d");
+  EXPECT_EQ(error_of(jump), ": walk: expected no [walk] table: the controller \"jump2d\" does not walk");
+}
+
+// The constraint penalty on made-up walks.
+TEST(WalkConstraints, RangesFallsAndTurns) {
+  const Task task = load_task(kTasks + "silly_walk.toml");
+  const double K = task.constraints.weight;
+  auto walk_of = [](int n, double forward, double lateral, double tilt_deg, double turn) {
+    MotionSummary s;
+    for (int i = 0; i < n; ++i) {
+      WalkStep step;
+      step.leg = i % 2;
+      step.forward = forward;
+      step.lateral = (i % 2 ? -1 : 1) * lateral;
+      step.tilt = tilt_deg * M_PI / 180;
+      step.heading = i >= 10 ? turn * (i - 9) / 20.0 : 0;
+      s.walk.steps.push_back(step);
+    }
+    return s;
+  };
+  EXPECT_EQ(evaluate_constraints(task, walk_of(30, 1.0, 0.2, 5, 0)).total, 0);
+  EXPECT_NEAR(constraint_margin(task, walk_of(30, 1.0, 0.2, 5, 0)), 10 * M_PI / 180, 1e-12);  // the tilt's
+  // Every evaluated step 0.2 m short: 20 steps of K 0.2^2; the settling steps do not count.
+  MotionSummary short_steps = walk_of(30, 0.3, 0.2, 5, 0);
+  for (int i = 0; i < 10; ++i) short_steps.walk.steps[static_cast<size_t>(i)].forward = -3;
+  EXPECT_NEAR(evaluate_constraints(task, short_steps).total, K * 20 * 0.04, 1e-6);
+  EXPECT_NEAR(constraint_margin(task, short_steps), -0.2, 1e-12);
+  EXPECT_NEAR(evaluate_constraints(task, walk_of(30, 1.0, 0.7, 5, 0)).total, K * 20 * 0.04, 1e-6);
+  // Leaning 20 degrees: 5 degrees over on each evaluated step.
+  const double over = 5 * M_PI / 180;
+  EXPECT_NEAR(evaluate_constraints(task, walk_of(30, 1.0, 0.2, 20, 0)).total, K * 20 * over * over, 1e-6);
+  // Turning 40 degrees over the evaluated steps: 10 over.
+  const double turn = 10 * M_PI / 180;
+  EXPECT_NEAR(evaluate_constraints(task, walk_of(30, 1.0, 0.2, 5, 40 * M_PI / 180)).total, K * turn * turn, 1e-6);
+  // Falls: 50,000 in the first step, linearly to 0 after the 30th.
+  for (const int taken : {0, 15, 29}) {
+    MotionSummary s = walk_of(taken, 1.0, 0.2, 5, 0);
+    s.fell = true;
+    const ConstraintReport r = evaluate_constraints(task, s);
+    EXPECT_TRUE(r.fell);
+    EXPECT_NEAR(r.total, 50000.0 * (1 - taken / 30.0), 1e-6) << taken;
+    EXPECT_EQ(constraint_margin(task, s), -1);
+  }
+  MotionSummary blew_up;
+  blew_up.unstable = true;
+  EXPECT_EQ(evaluate_constraints(task, blew_up).total, 150000);
+}
+
+void expect_meets(const std::string& name) {
+  const TaskEvaluator ev(load_task(kTasks + name + ".toml"));
+  const ParameterSet p = ev.load_parameters(ev.task().seed.base);
+  const auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(p.values(), *worker);
+  ASSERT_FALSE(e.failed) << e.failure;
+  EXPECT_FALSE(e.fell) << e.summary.fall_reason;
+  EXPECT_EQ(e.constraint, 0);
+  const auto& steps = e.summary.walk.steps;
+  ASSERT_EQ(steps.size(), 30u);
+  for (size_t i = 0; i < steps.size(); ++i) EXPECT_EQ(steps[i].leg, static_cast<int>(i % 2)) << i;
+  // The rollout stops at the last touch-down.
+  EXPECT_NEAR(e.stats.time, steps.back().time, 1e-9);
+  EXPECT_GT(constraint_margin(ev.task(), e.summary), 0);
+  // 10 evaluated strides, 4 states, 10 samples each, in state order.
+  ASSERT_EQ(e.poses.size(), 400u);
+  for (size_t k = 0; k < e.poses.size(); ++k) {
+    EXPECT_EQ(e.poses[k].phase, static_cast<int>((k / 10) % 4)) << k;
+    EXPECT_NEAR(e.poses[k].phase_time, (k % 10 + 0.5) / 10, 1e-12);
+    if (k > 0) {
+      EXPECT_GT(e.poses[k].time, e.poses[k - 1].time);
+    }
+  }
+  EXPECT_GE(e.poses.front().time, steps[9].time);
+  EXPECT_LE(e.poses.back().time, steps.back().time);
+  // The same parameters give the same walk on another worker.
+  const auto other = ev.make_worker();
+  const Evaluation again = ev.evaluate(p.values(), *other);
+  EXPECT_EQ(again.stats.steps, e.stats.steps);
+  EXPECT_EQ(again.poses.back().link_com, e.poses.back().link_com);
+}
+
+TEST(WalkEvaluation, HumanStartMeetsTheTask) { expect_meets("silly_walk"); }
+TEST(WalkEvaluation, RobotStartMeetsTheTask) { expect_meets("robot_silly_walk"); }
+
+TEST(WalkEvaluation, FallEndsTheRollout) {
+  const TaskEvaluator ev(load_task(kTasks + "silly_walk.toml"));
+  ParameterSet p = ev.load_parameters(ev.task().seed.base);
+  // Torso bent forward to its limit, no balance feedback: it falls within a few steps.
+  p.set("lift.torso.waist", p.specs()[static_cast<size_t>(p.find("lift.torso.waist"))].lower);
+  p.set("strike.torso.waist", p.specs()[static_cast<size_t>(p.find("strike.torso.waist"))].lower);
+  const auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(p.values(), *worker);
+  ASSERT_TRUE(e.fell);
+  EXPECT_LT(e.summary.walk.steps.size(), 30u);
+  EXPECT_NEAR(e.stats.time, e.summary.end_time, 1e-9);
+  EXPECT_LT(e.stats.time, 20.0);
+  ASSERT_EQ(e.report.terms.front().name, "fall");
+  EXPECT_NEAR(e.report.terms.front().penalty, 50000.0 * (1 - e.summary.walk.steps.size() / 30.0), 1e-6);
+  EXPECT_TRUE(e.poses.empty());
+}
+
+}  // namespace
+}  // namespace diverse
