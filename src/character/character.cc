@@ -461,7 +461,10 @@ Character bind_character(std::shared_ptr<const CharacterSpec> spec_ptr, const mj
     high = std::max(high, hi);
   }
   for (CharacterJoint& j : c.joints) {
-    for (int k = 0; k < 3; ++k) j.anchor0[static_cast<size_t>(k)] = d->xanchor[3 * j.joint + k];
+    for (int k = 0; k < 3; ++k) {
+      j.anchor0[static_cast<size_t>(k)] = d->xanchor[3 * j.joint + k];
+      j.axis0[static_cast<size_t>(k)] = d->xaxis[3 * j.joint + k];
+    }
     j.standing = m->qpos0[j.qpos];
   }
   mj_deleteData(d);

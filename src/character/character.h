@@ -105,6 +105,7 @@ struct CharacterJoint {
   double lower = 0, upper = 0;  // range (rad); -inf/inf when unlimited
   double torque_limit = 0;      // Nm, the motor's forcerange
   std::array<double, 3> anchor0{};  // world position of the joint at the model's qpos0 (m)
+  std::array<double, 3> axis0{};    // world axis of the joint at the model's qpos0
   double standing = 0;              // the joint's angle at the model's qpos0 (rad)
 };
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "control/controller.h"
+#include "control/jump3d_controller.h"
 #include "control/jump_controller.h"
 #include "control/walk_controller.h"
 
@@ -12,6 +13,7 @@ namespace diverse {
 std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   std::vector<std::unique_ptr<ControllerType>> types;
   types.push_back(std::make_unique<JumpControllerType>());
+  types.push_back(std::make_unique<Jump3dControllerType>());
   types.push_back(std::make_unique<WalkControllerType>());
   return types;
 }

@@ -134,7 +134,7 @@ void rotation_error(const double* target, const double* q, double* e) {
 }
 
 // Heading (yaw about world z) of a body's x axis, from its orientation quaternion.
-double heading(const double* quat) {
+double yaw_of(const double* quat) {
   double R[9];
   mju_quat2Mat(R, quat);
   return std::atan2(R[3], R[0]);
@@ -164,6 +164,8 @@ StanceController::StanceController(const Character& body, const mjModel* m, Stan
   for (int k = 0; k < n; ++k) {
     const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
     targets_[static_cast<size_t>(k)] = m->qpos0[j.qpos];
+    kp_.push_back(body.groups[static_cast<size_t>(j.group)].kp);
+    kd_gain_.push_back(body.groups[static_cast<size_t>(j.group)].kd);
     index_of[static_cast<size_t>(j.joint)] = k;
     if (m->body_parentid[j.body] == root) root_children_.push_back(k);
   }
@@ -335,13 +337,91 @@ bool StanceController::foot_contact(const mjData* d, int side) const {
   return false;
 }
 
+void StanceController::set_pitches(double root, double torso, double foot) {
+  pitch_root_ = root;
+  pitch_torso_ = torso;
+  pitch_foot_ = foot;
+  update_targets();
+}
+
+void StanceController::set_joint_gains(int k, double kp, double kd) {
+  kp_.at(static_cast<size_t>(k)) = kp;
+  kd_gain_.at(static_cast<size_t>(k)) = kd;
+}
+
+void StanceController::set_root_gains(double kp, double kd) {
+  root_kp_ = kp;
+  root_kd_ = kd;
+}
+
 void StanceController::reset(const mjModel* m, const mjData* d) {
   measure(m, d);
   height_target_ = com_[2];
   const int root = body_.root_body;
-  const double turn = heading(d->xquat + 4 * root) - heading(root_standing_.data());
-  const double yaw[4] = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
-  mju_mulQuat(root_target_.data(), yaw, root_standing_.data());
+  heading_ = yaw_of(d->xquat + 4 * root);
+  const double turn = heading_ - yaw_of(root_standing_.data());
+  heading_quat_ = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
+  update_targets();
+}
+
+StanceController::Pitches StanceController::measured_pitches(const mjData* d) const {
+  const double h[2] = {std::cos(heading_), std::sin(heading_)};
+  // Pitch (positive backwards) of a forward axis: its elevation along the heading.
+  auto elevation = [&](const double* x) { return std::atan2(x[2], x[0] * h[0] + x[1] * h[1]); };
+  auto forward = [](const double* quat, double* x) {
+    double R[9];
+    mju_quat2Mat(R, quat);
+    x[0] = R[0];
+    x[1] = R[3];
+    x[2] = R[6];
+  };
+  Pitches p;
+  double standing[4], x[3];
+  mju_mulQuat(standing, heading_quat_.data(), root_standing_.data());
+  const int root = body_.root_body;
+  forward(standing, x);
+  const double root0 = elevation(x);
+  {  // d->xmat's first column is at 0, 3, 6
+    const double* R = d->xmat + 9 * root;
+    const double col[3] = {R[0], R[3], R[6]};
+    p.root = elevation(col) - root0;
+  }
+  p.torso = p.root;
+  if (torso_body_ >= 0) {
+    double torso[4];
+    mju_mulQuat(torso, standing, torso_in_root_.data());
+    forward(torso, x);
+    const double* R = d->xmat + 9 * torso_body_;
+    const double col[3] = {R[0], R[3], R[6]};
+    p.torso = elevation(col) - elevation(x);
+  }
+  double foot = 0;
+  for (int s = 0; s < 2; ++s) {
+    double up[3];
+    mju_mulMatVec(up, d->xmat + 9 * body_.feet[static_cast<size_t>(s)], foot_up_[static_cast<size_t>(s)].data(), 3, 3);
+    foot += 0.5 * std::atan2(-(up[0] * h[0] + up[1] * h[1]), up[2]);
+  }
+  p.foot = foot;
+  return p;
+}
+
+void StanceController::update_targets() {
+  // A turn by `pitch` about minus the heading's lateral axis (-sin h, cos h, 0).
+  auto pitched = [&](double pitch, const double* q, double* out) {
+    const double s = std::sin(pitch / 2);
+    const double p[4] = {std::cos(pitch / 2), s * std::sin(heading_), -s * std::cos(heading_), 0};
+    mju_mulQuat(out, p, q);
+  };
+  double standing[4], torso[4];
+  mju_mulQuat(standing, heading_quat_.data(), root_standing_.data());
+  pitched(pitch_root_, standing, root_target_.data());
+  mju_mulQuat(torso, standing, torso_in_root_.data());
+  pitched(pitch_torso_, torso, torso_target_.data());
+  const double identity[4] = {1, 0, 0, 0};
+  double foot[4];
+  pitched(pitch_foot_, identity, foot);
+  const double z[3] = {0, 0, 1};
+  mju_rotVecQuat(foot_up_target_.data(), z, foot);
 }
 
 void StanceController::control(const mjModel* m, const mjData* d, JointDrive& drive) {
@@ -401,18 +481,19 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
         M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * com_vel_[0]);
     double fy =
         M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * com_vel_[1]);
-    double fz = M * (gravity_ + gains_.height_kp * (height_target_ - com_[2]) -
-                     gains_.height_kd * com_vel_[2]);
+    const double servo = com_force_ == ComForce::kBalance ? gains_.height_kp * (height_target_ - com_[2]) : 0;
+    double fz = M * (gravity_ + servo - gains_.height_kd * com_vel_[2]);
     fz = std::max(fz, 0.1 * M * gravity_);
     // Keep the centre of pressure inside the support polygon.
     const double h = std::max(com_[2] - sole, 0.05);
     const std::vector<Vec2> polygon = shrink(convex_hull(corners), gains_.cop_margin);
     const Vec2 cop{com_[0] - h * fx / fz, com_[1] - h * fy / fz};
     const Vec2 held = project(polygon, cop);
-    if (held != cop) {
+    if (held != cop && com_force_ != ComForce::kPush) {
       fx = (com_[0] - held[0]) * fz / h;
       fy = (com_[1] - held[1]) * fz / h;
     }
+    if (com_force_ == ComForce::kNone) fx = fy = fz = 0;
     force_ = {fx, fy, fz};
 
     // Share the load: the centre of pressure `held` between the soles' centres gives each
@@ -448,13 +529,12 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
   // Default: PD toward the targets, gravity compensation off the stance legs.
   for (int k = 0; k < n; ++k) {
     const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-    const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
-    double u = g.kp * (targets_[static_cast<size_t>(k)] - d->qpos[j.qpos]);
+    double u = kp_[static_cast<size_t>(k)] * (targets_[static_cast<size_t>(k)] - d->qpos[j.qpos]);
     const int leg = leg_of_[static_cast<size_t>(k)];
     const bool in_stance = leg >= 0 && stance_[static_cast<size_t>(leg)];
     if (gains_.gravity_compensation && !in_stance) u += gravity_torque(m, d, j, gravity_);
     u_[static_cast<size_t>(k)] = u;
-    kd_[static_cast<size_t>(k)] = g.kd;
+    kd_[static_cast<size_t>(k)] = kd_gain_[static_cast<size_t>(k)];
   }
 
   // Feet flat: the rotation that takes the foot's standing up vector to world up.
@@ -464,7 +544,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     const double* up0 = foot_up_[static_cast<size_t>(s)].data();
     double up[3];
     mju_mulMatVec(up, R, up0, 3, 3);
-    const double z[3] = {0, 0, 1};
+    const double* z = foot_up_target_.data();
     double e[3];
     mju_cross(e, up, z);
     const double sin_angle = mju_norm3(e);
@@ -473,27 +553,26 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     const double* w_parent = d->cvel + 6 * m->body_parentid[foot];
     for (int k : legs_[static_cast<size_t>(s)].foot) {
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
       const double* a = d->xaxis + 3 * j.joint;
-      u_[static_cast<size_t>(k)] = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
-      kd_[static_cast<size_t>(k)] = g.kd;
+      const double kp = kp_[static_cast<size_t>(k)], kd = kd_gain_[static_cast<size_t>(k)];
+      u_[static_cast<size_t>(k)] = kp * dot3(a, e) - kd * dot3(a, w_parent);
+      kd_[static_cast<size_t>(k)] = kd;
     }
   }
 
   // Torso: its standing orientation relative to the root's target, in world.
   if (torso_body_ >= 0) {
-    double target[4], e[3];
-    mju_mulQuat(target, root_target_.data(), torso_in_root_.data());
-    rotation_error(target, d->xquat + 4 * torso_body_, e);
+    double e[3];
+    rotation_error(torso_target_.data(), d->xquat + 4 * torso_body_, e);
     const double* w_parent = d->cvel + 6 * m->body_parentid[torso_body_];
     for (int k : waist_) {
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
       const double* a = d->xaxis + 3 * j.joint;
-      double u = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
+      const double kp = kp_[static_cast<size_t>(k)], kd = kd_gain_[static_cast<size_t>(k)];
+      double u = kp * dot3(a, e) - kd * dot3(a, w_parent);
       if (gains_.gravity_compensation) u += gravity_torque(m, d, j, gravity_);
       u_[static_cast<size_t>(k)] = u;
-      kd_[static_cast<size_t>(k)] = g.kd;
+      kd_[static_cast<size_t>(k)] = kd;
     }
   }
 

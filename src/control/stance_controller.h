@@ -97,6 +97,39 @@ class StanceController {
   // Where the COM is held relative to the centre of the stance soles (m, world x, y).
   void set_com_offset(double x, double y) { offset_ = {x, y}; }
 
+  // Adjustments for a controller that runs stance control as phases of a larger state
+  // machine (control/jump3d_controller.h).
+  //
+  // Pitches (rad) turn the root, the torso and the feet from their standing orientation
+  // about the lateral axis of the heading taken at reset() (positive backwards, as the
+  // joints about -y turn): the root's target becomes pitch(root) * heading * standing, and
+  // likewise the torso's target and the feet's "up". All 0 (the default) is standing.
+  void set_pitches(double root, double torso, double foot);
+  // PD gains of joint k (its group's by default). For a foot joint they are the gains of
+  // the foot's world tracking, for the tracked waist those of the torso's; a stance hip
+  // takes none (the root's gains act through it).
+  void set_joint_gains(int k, double kp, double kd);
+  // The root's orientation gains (Nm/rad, Nm s/rad; by default StanceGains').
+  void set_root_gains(double kp, double kd);
+  // What the virtual force on the COM does. kBalance: both servos (the default). kSupport:
+  // F_xy as usual and F_z = M (g - height_kd v_z), no height servo, so the joint targets
+  // decide how low the body goes. kPush: as kSupport, but F_xy is not held to the support
+  // polygon: the legs push the COM toward its goal even if that tips the feet (a jump's
+  // take-off; the joint drive still limits every torque). kNone: no virtual force; the
+  // stance legs only hold the root's orientation and the feet track theirs.
+  enum class ComForce { kBalance, kSupport, kPush, kNone };
+  void set_com_force(ComForce mode) { com_force_ = mode; }
+  // The heading (rad, yaw of the root's x axis about world z) taken at reset().
+  double heading() const { return heading_; }
+  // The pitches set_pitches() takes, as they are in the state d (after mj_kinematics): of
+  // the root's and the torso's forward axes and of the feet's "up" (their mean), each
+  // relative to standing, about the heading's lateral axis. The torso's is the root's when
+  // there is no waist.
+  struct Pitches {
+    double root = 0, torso = 0, foot = 0;
+  };
+  Pitches measured_pitches(const mjData* d) const;
+
   // A start pose for standing: the model's qpos0 with each leg leaned about its foot (the
   // sagittal hinges of the hips turned by -theta and of the feet by +theta, so the root
   // stays upright and the soles flat, the root moved so the soles stay where they were)
@@ -133,6 +166,9 @@ class StanceController {
   StanceGains gains_;
   std::vector<double> targets_;
   std::array<double, 2> offset_{0, 0};
+  ComForce com_force_ = ComForce::kBalance;
+  double pitch_root_ = 0, pitch_torso_ = 0, pitch_foot_ = 0;
+  std::vector<double> kp_, kd_gain_;  // per joint: PD gains
 
   // Structure, found once.
   std::array<Leg, 2> legs_;
@@ -148,8 +184,13 @@ class StanceController {
   double mass_ = 0, gravity_ = 9.81;
   double root_kp_ = 0, root_kd_ = 0;
 
-  // Targets taken at reset().
+  // Targets taken at reset() (and set_pitches()).
+  void update_targets();
+  double heading_ = 0;
+  std::array<double, 4> heading_quat_{1, 0, 0, 0};  // yaw of the heading relative to standing
   std::array<double, 4> root_target_{1, 0, 0, 0};
+  std::array<double, 4> torso_target_{1, 0, 0, 0};
+  std::array<double, 3> foot_up_target_{0, 0, 1};
   double height_target_ = 0;
 
   // Per step.

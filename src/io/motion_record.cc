@@ -29,8 +29,10 @@ nlohmann::json summary_json(const MotionSummary& s) {
           {"landed", s.landed},               {"settled", s.settled},
           {"fell", s.fell},                   {"fall_reason", s.fall_reason},
           {"peak_com_z", s.peak_com_z},       {"feet_x", s.feet_x},
-          {"feet_z", s.feet_z},               {"touchdown_feet_x", s.touchdown_feet_x},
+          {"feet_y", s.feet_y},               {"feet_z", s.feet_z},
+          {"touchdown_feet_x", s.touchdown_feet_x}, {"touchdown_feet_y", s.touchdown_feet_y},
           {"touchdown_feet_z", s.touchdown_feet_z}, {"rotation_total", s.rotation_total},
+          {"max_forward_pitch", s.max_forward_pitch},
           {"rotation_flight", s.rotation_flight}, {"min_clearance", s.min_clearance},
           {"end_time", s.end_time}};
   if (!s.walk.steps.empty()) {

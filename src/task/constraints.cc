@@ -29,7 +29,12 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
     return std::max(violation(motion.touchdown_feet_x, motion.touchdown_feet_z),
                     violation(motion.feet_x, motion.feet_z));
   };
-  if (c.landing) {
+  if (c.landing && c.landing_radius > 0) {
+    const double touchdown = std::hypot(motion.touchdown_feet_x - c.landing_center,
+                                        motion.touchdown_feet_y - c.landing_lateral);
+    const double rest = std::hypot(motion.feet_x - c.landing_center, motion.feet_y - c.landing_lateral);
+    quadratic("landing", std::max(0.0, std::max(touchdown, rest) - c.landing_radius));
+  } else if (c.landing) {
     quadratic("landing", at_touchdown_and_rest([&](double x, double) {
                 return std::max(0.0, std::fabs(x - c.landing_center) - c.landing_half_width);
               }));
@@ -60,6 +65,9 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
                                        c.rotation_tolerance);
     add("rotation", d, d > 0 ? c.rotation_penalty + c.weight * d * d : 0);
   }
+  if (c.pitch) {
+    quadratic("pitch", std::max(0.0, motion.max_forward_pitch - c.max_pitch));
+  }
   return report;
 }
 
@@ -67,8 +75,17 @@ double constraint_margin(const Task& task, const MotionSummary& motion) {
   if (task.walk.enabled) return walk_margin(task, motion);
   const TaskConstraints& c = task.constraints;
   double margin = 1.0;  // m; no constraint is looser than this counts
+  if (c.landing && c.landing_radius > 0) {
+    margin = std::min({margin,
+                       c.landing_radius - std::hypot(motion.touchdown_feet_x - c.landing_center,
+                                                     motion.touchdown_feet_y - c.landing_lateral),
+                       c.landing_radius - std::hypot(motion.feet_x - c.landing_center,
+                                                     motion.feet_y - c.landing_lateral)});
+  }
+  if (c.pitch) margin = std::min(margin, 0.2 * (c.max_pitch - motion.max_forward_pitch));
   for (const double x : {motion.touchdown_feet_x, motion.feet_x}) {
-    if (c.landing) margin = std::min(margin, c.landing_half_width - std::fabs(x - c.landing_center));
+    if (c.landing && c.landing_radius <= 0)
+      margin = std::min(margin, c.landing_half_width - std::fabs(x - c.landing_center));
     if (c.on_box) {
       const SceneObject* box = task.find_object(c.on_box_object);
       const double lo = box->x_min + c.on_box_margin, hi = box->x_max - c.on_box_margin;

@@ -35,11 +35,12 @@ struct MotionSummary {
   std::string fall_reason;    // empty unless fell
   double fall_progress = 1;   // how far the motion got before falling, in [0, 1]
   double peak_com_z = 0;      // m, highest whole-body COM during flight
-  double feet_x = 0, feet_z = 0;   // m, mean of the foot centres at the end
-  double touchdown_feet_x = 0, touchdown_feet_z = 0;  // m, the same at the first touch-down
+  double feet_x = 0, feet_y = 0, feet_z = 0;   // m, mean of the foot centres at the end
+  double touchdown_feet_x = 0, touchdown_feet_y = 0, touchdown_feet_z = 0;  // m, the same at the first touch-down
   double rotation_total = 0;  // rad, root pitch at the end minus at the start
   double rotation_flight = 0; // rad, root pitch at landing minus at take-off
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
+  double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
   WalkSummary walk;           // a walk task's steps (task/walk_task.h)
 };

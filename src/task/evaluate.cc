@@ -41,7 +41,22 @@ class JumpHooks : public StepHooks {
     if (first_) {
       pitch0_ = pitch;
       first_ = false;
+      if (body_.root == RootKind::kFree) {
+        // The root's standing "up" and forward axes in its own frame (from qpos0).
+        const double* q0 = m->qpos0 + body_.root_qpos + 3;
+        const double inv[4] = {q0[0], -q0[1], -q0[2], -q0[3]};
+        const double z[3] = {0, 0, 1}, x[3] = {1, 0, 0};
+        mju_rotVecQuat(up0_, z, inv);
+        double fwd0[3];
+        mju_rotVecQuat(fwd0, x, inv);
+        // Forward pitch is measured against the standing forward axis's elevation.
+        double w[3];
+        mju_rotVecQuat(w, fwd0, q0);
+        elevation0_ = std::atan2(w[2], std::hypot(w[0], w[1]));
+        for (int i = 0; i < 3; ++i) fwd0_[i] = fwd0[i];
+      }
     }
+    s.max_forward_pitch = std::max(s.max_forward_pitch, forward_pitch(d, pitch));
     const double com_z = controller_.com()[2];
 
     // Events.
@@ -60,6 +75,7 @@ class JumpHooks : public StepHooks {
       s.landed = true;
       s.rotation_flight = pitch - pitch_takeoff_;
       s.touchdown_feet_x = feet_mean(d, 0);
+      s.touchdown_feet_y = feet_mean(d, 1);
       s.touchdown_feet_z = feet_mean(d, 2);
     }
 
@@ -80,6 +96,9 @@ class JumpHooks : public StepHooks {
       if (com_z - feet_z < task_.simulation.fall_com_height) {
         return fall(t, "the centre of mass dropped to the feet", d);
       }
+      if (task_.simulation.fall_tilt > 0 && tilt(d, pitch) > task_.simulation.fall_tilt) {
+        return fall(t, "the body tipped over", d);
+      }
     }
 
     // End of the motion.
@@ -87,7 +106,7 @@ class JumpHooks : public StepHooks {
     if (s.landed) {
       const double since = t - controller_.phase_times().landing();
       const auto& v = controller_.com_velocity();
-      if (since >= sim.settle_time && std::hypot(v[0], v[2]) < sim.settle_speed) {
+      if (since >= sim.settle_time && std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) < sim.settle_speed) {
         s.settled = true;
         return finish(t, d);
       }
@@ -109,6 +128,23 @@ class JumpHooks : public StepHooks {
       return (land_ + std::min(1.0, since / task_.simulation.settle_time)) / phases;
     }
     return static_cast<double>(std::min(phase, land_)) / phases;
+  }
+
+  // The root's forward pitch from standing (rad, positive forward): the planar root's
+  // hinge (positive backwards), or a free root's forward axis's elevation below standing.
+  double forward_pitch(const mjData* d, double pitch) const {
+    if (body_.root == RootKind::kPlanar) return -(pitch - pitch0_);
+    double w[3];
+    mju_mulMatVec(w, d->xmat + 9 * body_.root_body, fwd0_, 3, 3);
+    return elevation0_ - std::atan2(w[2], std::hypot(w[0], w[1]));
+  }
+
+  // The root's tilt from standing upright (rad).
+  double tilt(const mjData* d, double pitch) const {
+    if (body_.root == RootKind::kPlanar) return std::fabs(pitch - pitch0_);
+    double up[3];
+    mju_mulMatVec(up, d->xmat + 9 * body_.root_body, up0_, 3, 3);
+    return std::acos(std::clamp(up[2], -1.0, 1.0));
   }
 
   // Mean over the two feet's centres of mass of world coordinate `axis` (0 = x, 2 = z).
@@ -142,9 +178,11 @@ class JumpHooks : public StepHooks {
     MotionSummary& s = out_.summary;
     s.end_time = t;
     s.feet_x = feet_mean(d, 0);
+    s.feet_y = feet_mean(d, 1);
     s.feet_z = feet_mean(d, 2);
     if (!s.landed) {  // never touched down: the end position stands for both
       s.touchdown_feet_x = s.feet_x;
+      s.touchdown_feet_y = s.feet_y;
       s.touchdown_feet_z = s.feet_z;
     }
     s.rotation_total = last_pitch_ - pitch0_;
@@ -161,6 +199,8 @@ class JumpHooks : public StepHooks {
   ContactState contacts_;
   bool first_ = true;
   double pitch0_ = 0, pitch_takeoff_ = 0, last_pitch_ = 0, free_pitch_ = 0;
+  double up0_[3] = {0, 0, 1}, fwd0_[3] = {1, 0, 0};  // free root: standing axes in its frame
+  double elevation0_ = 0;                            // rad, the standing forward axis's
 };
 
 }  // namespace

@@ -163,6 +163,13 @@ Task with_height(const Task& task, double height) {
   return t;
 }
 
+// The task with its landing constraint's centre at `x`.
+Task with_distance(const Task& task, double x) {
+  Task t = task;
+  t.constraints.landing_center = x;
+  return t;
+}
+
 }  // namespace
 
 SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOptions& options) {
@@ -171,15 +178,19 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   result.parameters = start;
   result.lowest_mean = start;
   Eigen::VectorXd x = start.normalized();
-  std::vector<double> heights = task.seed.heights;
-  if (task.seed.object.empty()) heights = {-1};
+  // Continuation stages: an object's heights, landing distances, or the task alone.
+  const bool by_distance = !task.seed.distances.empty();
+  std::vector<double> heights = by_distance ? task.seed.distances : task.seed.heights;
+  if (task.seed.object.empty() && !by_distance) heights = {-1};
   const int generations = options.generations > 0 ? options.generations : task.seed.generations;
   ThreadPool pool(std::max(1, options.threads));
   char line[320];
 
   for (size_t stage = 0; stage < heights.size(); ++stage) {
     const bool last = stage + 1 == heights.size();
-    const Task stage_task = heights[stage] < 0 ? task : with_height(task, heights[stage]);
+    const Task stage_task = by_distance        ? with_distance(task, heights[stage])
+                            : heights[stage] < 0 ? task
+                                                 : with_height(task, heights[stage]);
     const TaskEvaluator ev(stage_task);
     const TaskEvaluator fine(halved(stage_task, ev.model().get()));
     std::vector<std::unique_ptr<SimWorker>> workers, fine_workers;
@@ -207,8 +218,9 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     result.evaluations += static_cast<long long>(2 + robust.directions.size());
     if (options.log) {
       std::snprintf(line, sizeof(line),
-                    "stage %zu (height %.3f m): start f=%.6g C=%.6g margin=%.3f met=%.3f", stage,
-                    heights[stage], best.f, best.constraint, best.margin, best.met);
+                    "stage %zu (%s %.3f m): start f=%.6g C=%.6g margin=%.3f met=%.3f", stage,
+                    by_distance ? "landing at" : "height", heights[stage], best.f, best.constraint, best.margin,
+                    best.met);
       options.log(line);
     }
     if (last) {
@@ -300,7 +312,8 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
 }
 
 double landing_shift(const MotionSummary& a, const MotionSummary& b) {
-  return std::max(std::fabs(a.touchdown_feet_x - b.touchdown_feet_x), std::fabs(a.feet_x - b.feet_x));
+  return std::max(std::hypot(a.touchdown_feet_x - b.touchdown_feet_x, a.touchdown_feet_y - b.touchdown_feet_y),
+                  std::hypot(a.feet_x - b.feet_x, a.feet_y - b.feet_y));
 }
 
 std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,

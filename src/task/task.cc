@@ -80,16 +80,23 @@ void require_object(const TomlReader& r, const Task& task, const char* key, cons
 
 void read_constraints(const TomlReader& r, Task& task) {
   r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
-          "peak_height", "rotation"});
+          "peak_height", "rotation", "pitch"});
   TaskConstraints& c = task.constraints;
   c.weight = r.number("weight", 1e-6, 1e9);
   c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
   if (auto t = r.table("landing", false)) {
     TomlReader s = r.sub("landing", *t);
-    s.only({"center", "half_width"});
+    s.only({"center", "half_width", "lateral", "radius"});
     c.landing = true;
     c.landing_center = s.number("center", -20, 20);
-    c.landing_half_width = s.number("half_width", 0.001, 10);
+    if (s.has("radius")) {
+      if (s.has("half_width")) s.fail("radius", "expected either half_width (a box along x) or radius (a disc), not both");
+      c.landing_radius = s.number("radius", 0.001, 10);
+      c.landing_lateral = s.number("lateral", -20, 20, 0.0);
+    } else {
+      if (s.has("lateral")) s.fail("lateral", "expected lateral only with a radius (a disc)");
+      c.landing_half_width = s.number("half_width", 0.001, 10);
+    }
   }
   if (auto t = r.table("on_box", false)) {
     TomlReader s = r.sub("on_box", *t);
@@ -127,17 +134,24 @@ void read_constraints(const TomlReader& r, Task& task) {
     c.rotation_tolerance = s.number("tolerance", 0.01, 3.14);
     c.rotation_penalty = s.number("penalty", 0, 1e12);
   }
+  if (auto t = r.table("pitch", false)) {
+    TomlReader s = r.sub("pitch", *t);
+    s.only({"max"});
+    c.pitch = true;
+    c.max_pitch = s.number("max", 0.01, 3.14);
+  }
 }
 
 void read_simulation(const TomlReader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
-          "clearance_range", "timestep"});
+          "fall_tilt", "clearance_range", "timestep"});
   TaskSimulation& s = task.simulation;
   s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
   s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
   s.settle_max = r.number("settle_max", s.settle_time, 20, std::max(s.settle_max, s.settle_time));
   s.max_time = r.number("max_time", 0.5, 60, s.max_time);
   s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
+  s.fall_tilt = r.number("fall_tilt", 0, 3.14, s.fall_tilt);
   s.clearance_range = r.number("clearance_range", 0.01, 2, s.clearance_range);
   s.timestep = r.number("timestep", 0, 0.01, s.timestep);
   if (s.timestep != 0 && s.timestep < 1e-5)
@@ -145,7 +159,7 @@ void read_simulation(const TomlReader& r, Task& task) {
 }
 
 void read_seed(const TomlReader& r, Task& task) {
-  r.only({"base", "object", "heights", "generations", "sigma", "popsize", "seed", "robustness"});
+  r.only({"base", "object", "heights", "distances", "generations", "sigma", "popsize", "seed", "robustness"});
   TaskSeed& s = task.seed;
   s.base = existing_file(r, "base");
   s.object = r.string("object", "");
@@ -165,6 +179,23 @@ void read_seed(const TomlReader& r, Task& task) {
   }
   if (!s.object.empty() && s.heights.empty()) {
     r.fail("heights", "expected continuation heights for the object (missing)");
+  }
+  if (r.has("distances")) {
+    const toml::array* a = r.raw().get("distances")->as_array();
+    if (a == nullptr || a->empty()) r.fail("distances", "expected a non-empty array of numbers in [-20, 20]");
+    for (const toml::node& n : *a) {
+      double v = 1e9;
+      if (auto f = n.as_floating_point()) v = f->get();
+      if (auto i = n.as_integer()) v = static_cast<double>(i->get());
+      if (!(v >= -20 && v <= 20)) r.fail("distances", "expected a non-empty array of numbers in [-20, 20]");
+      s.distances.push_back(v);
+    }
+    if (!s.object.empty()) r.fail("distances", "expected either an object's heights or landing distances, not both");
+    if (!task.constraints.landing) r.fail("distances", "expected a landing constraint to move (constraints.landing)");
+    if (s.distances.back() != task.constraints.landing_center) {
+      r.fail("distances", "expected the last distance to be the task's landing centre (" +
+                              std::to_string(task.constraints.landing_center) + ")");
+    }
   }
   s.generations = static_cast<int>(r.integer("generations", 1, 100000, s.generations));
   s.sigma = r.number("sigma", 1e-4, 1, s.sigma);

@@ -40,9 +40,13 @@ struct TaskConstraints {
   double fall_penalty = 100000;   // constant for a fall (doubles for the earliest falls)
   // The landing constraints (landing, on_box, min_length) hold for the feet at the first
   // touch-down after flight and at rest (see task/constraints.h).
-  // Landing box: feet (mean of the two foot centres) within center +- half_width (x).
+  // Landing box: feet (mean of the two foot centres) within center +- half_width (x); or,
+  // with a radius (3D characters), within `radius` of the point (center, lateral) in the
+  // ground plane (x, y).
   bool landing = false;
   double landing_center = 0, landing_half_width = 0.15;  // m
+  double landing_lateral = 0;                            // m, y of the landing point
+  double landing_radius = 0;                             // m; > 0: a disc instead of a box
   // On top of a box object, at least `on_box_margin` from its edges.
   bool on_box = false;
   std::string on_box_object;
@@ -62,6 +66,10 @@ struct TaskConstraints {
   double rotation_turns = 1;        // full turns, positive = backwards
   double rotation_tolerance = 0.5;  // rad
   double rotation_penalty = 100000; // constant added when violated
+  // The root's forward pitch (rad, from standing, about the world's lateral axis) at most
+  // `max_pitch` throughout the motion (the bird robot's long jump).
+  bool pitch = false;
+  double max_pitch = 0;
 };
 
 struct TaskSimulation {
@@ -70,6 +78,10 @@ struct TaskSimulation {
   double settle_max = 2.5;        // s after landing by which it must be at rest
   double max_time = 6.0;          // s, hard cap of a rollout
   double fall_com_height = 0.3;   // m: COM closer than this to the feet's height = fall
+  // rad: on the ground (not in flight), the root tilting farther than this from its
+  // standing "up" is a fall; 0 = not checked (the planar tasks, whose falls show as
+  // contacts).
+  double fall_tilt = 0;
   double clearance_range = 0.3;   // m: distance up to which obstacle proximity is seen
   double timestep = 0;            // s; > 0 overrides the model's timestep
 };
@@ -78,6 +90,9 @@ struct TaskSeed {
   std::string base;               // resolved path of the hand-authored start parameters
   std::string object;             // continuation object ("" = none)
   std::vector<double> heights;    // continuation heights (m), last = the task's height
+  // Continuation over where the character lands (m, the landing constraint's centre),
+  // last = the task's; instead of an object's heights.
+  std::vector<double> distances;
   int generations = 100;          // CMA-ES generations per continuation stage (max)
   double sigma = 0.08;            // initial CMA-ES step (normalized units)
   int popsize = 16;

@@ -73,7 +73,9 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"jump_forward", {0.01, 32, 12}},
     {"jump_onto", {0.02, 8, 1}},
     {"jump_over", {0.01, 32, 2}},
-    {"jump_high", {0.02, 8, 1}}};
+    {"jump_high", {0.02, 8, 1}},
+    {"jump_backwards", {0.01, 16, 6}},
+    {"robot_jump", {0.01, 16, 2}}};
 
 TEST_P(M0, MeetsItsTask) {
   REQUIRE_M0(GetParam());
@@ -115,7 +117,7 @@ TEST_P(M0, SomeOfItsNeighbourhoodMeetsTheTask) {
 
 INSTANTIATE_TEST_SUITE_P(Tasks, M0,
                          ::testing::Values("backflip", "jump_forward", "jump_onto", "jump_over",
-                                           "jump_high"));
+                                           "jump_high", "jump_backwards", "robot_jump"));
 
 TEST(M0Specifics, BackflipTurnsOverOnce) {
   REQUIRE_M0("backflip");
@@ -159,6 +161,30 @@ TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
   EXPECT_GE(r.e.summary.min_clearance, 0.02);
   EXPECT_GE(r.e.summary.feet_x, 1.0);
   EXPECT_GE(r.e.summary.touchdown_feet_x, 1.0);
+}
+
+// The 3D human jumps backwards: the feet come down within 25 cm of the spot 0.8 m behind
+// the start (checked in the ground plane, sideways too), having flown most of the way, and
+// the body ends upright.
+TEST(M0Specifics, JumpBackwardsLandsBehindInTheDisc) {
+  REQUIRE_M0("jump_backwards");
+  const SimRun r = simulate("jump_backwards");
+  const MotionSummary& s = r.e.summary;
+  EXPECT_LT(std::hypot(s.touchdown_feet_x + 0.8, s.touchdown_feet_y), 0.25);
+  EXPECT_LT(std::hypot(s.feet_x + 0.8, s.feet_y), 0.25);
+  EXPECT_LT(s.touchdown_feet_x, -0.5);
+  EXPECT_GT(r.e.phases.landing() - r.e.phases.takeoff(), 0.2);
+}
+
+// The bird robot's long jump: down within 75 cm of the spot 4 m ahead, its body never
+// pitched forward more than the task's limit.
+TEST(M0Specifics, RobotJumpGoesFourMetres) {
+  REQUIRE_M0("robot_jump");
+  const SimRun r = simulate("robot_jump");
+  const MotionSummary& s = r.e.summary;
+  EXPECT_LT(std::hypot(s.touchdown_feet_x - 4.0, s.touchdown_feet_y), 0.75);
+  EXPECT_LT(std::hypot(s.feet_x - 4.0, s.feet_y), 0.75);
+  EXPECT_LE(s.max_forward_pitch, load_task(kTasks + "robot_jump.toml").constraints.max_pitch);
 }
 
 TEST(M0Specifics, JumpHighPeaksHighEnough) {

@@ -66,7 +66,7 @@ class TaskFileTest : public ::testing::Test {
 // controller that cannot drive the character says why before any simulation.
 TEST_F(TaskFileTest, ControllerTypeIsLookedUpAndCheckedAgainstTheCharacter) {
   EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"walk9\"")),
-            ": controller.type: expected one of \"jump2d\", \"walk3d\", got \"walk9\"");
+            ": controller.type: expected one of \"jump2d\", \"jump3d\", \"walk3d\", got \"walk9\"");
   EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"jump2d\"\nbounce = 2")),
             ": controller.bounce: expected no such key (unknown key; known keys: type, landing_control, "
             "landing_height, extend_timeout, balance_kp, balance_kd, balance_max_force, gravity_compensation)");
@@ -108,6 +108,47 @@ TEST_F(TaskFileTest, CommittedTasksParse) {
   EXPECT_TRUE(over.constraints.min_length);
   EXPECT_TRUE(load_task(kTasks + "backflip.toml").constraints.rotation);
   EXPECT_TRUE(load_task(kTasks + "jump_high.toml").constraints.peak_height);
+}
+
+// The 3D tasks: a landing disc in the ground plane, the robot's pitch limit, falls by tilt,
+// and the robot's seed continuation over the landing distance.
+TEST_F(TaskFileTest, ThreeDimensionalTasksParse) {
+  const Task back = load_task(kTasks + "jump_backwards.toml");
+  EXPECT_EQ(back.controller_type->name(), std::string("jump3d"));
+  EXPECT_EQ(back.character_spec->name, "human3d");
+  EXPECT_DOUBLE_EQ(back.constraints.landing_center, -0.8);
+  EXPECT_DOUBLE_EQ(back.constraints.landing_lateral, 0.0);
+  EXPECT_DOUBLE_EQ(back.constraints.landing_radius, 0.25);
+  EXPECT_DOUBLE_EQ(back.simulation.fall_tilt, 1.0);
+  EXPECT_FALSE(back.constraints.pitch);
+  const Task robot = load_task(kTasks + "robot_jump.toml");
+  EXPECT_EQ(robot.character_spec->name, "robot3d");
+  EXPECT_DOUBLE_EQ(robot.constraints.landing_radius, 0.75);
+  EXPECT_TRUE(robot.constraints.pitch);
+  EXPECT_DOUBLE_EQ(robot.constraints.max_pitch, 0.7);
+  EXPECT_EQ(robot.seed.distances, (std::vector<double>{2.0, 2.8, 3.5, 4.0}));
+}
+
+TEST_F(TaskFileTest, LandingDiscAndPitchErrors) {
+  const std::string disc = replace(valid_text(), "landing = { center = 1.0, half_width = 0.15 }",
+                                   "landing = { center = 1.0, lateral = 0.2, radius = 0.3 }");
+  const Task t = load_task(write(disc));
+  EXPECT_DOUBLE_EQ(t.constraints.landing_radius, 0.3);
+  EXPECT_DOUBLE_EQ(t.constraints.landing_lateral, 0.2);
+  EXPECT_EQ(error_of(replace(valid_text(), "half_width = 0.15", "half_width = 0.15, radius = 0.2")),
+            ": constraints.landing.radius: expected either half_width (a box along x) or radius (a disc), not both");
+  EXPECT_EQ(error_of(replace(valid_text(), "half_width = 0.15", "half_width = 0.15, lateral = 0.2")),
+            ": constraints.landing.lateral: expected lateral only with a radius (a disc)");
+  EXPECT_EQ(error_of(replace(disc, "radius = 0.3", "radius = -1")),
+            ": constraints.landing.radius: expected a number in [0.001, 10], got -1");
+  EXPECT_EQ(error_of(valid_text() + "pitch = { max = 4 }\n"),
+            ": constraints.pitch.max: expected a number in [0.01, 3.14], got 4");
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\nfall_tilt = -1\n"),
+            ": simulation.fall_tilt: expected a number in [0, 3.14], got -1");
+  EXPECT_EQ(error_of(valid_text() + "[seed]\nbase = \"" + kTasks + "base_jump.json\"\ndistances = [0.5, 0.9]\n"),
+            ": seed.distances: expected the last distance to be the task's landing centre (1.000000)");
+  EXPECT_EQ(error_of(valid_text() + "[seed]\nbase = \"" + kTasks + "base_jump.json\"\ndistances = \"far\"\n"),
+            ": seed.distances: expected a non-empty array of numbers in [-20, 20]");
 }
 
 TEST_F(TaskFileTest, ValidTextParses) {
@@ -256,6 +297,30 @@ TEST(Constraints, LandingIsMeasuredAtTouchdownAndAtRest) {
   o.touchdown_feet_x = 0.9;
   o.feet_x = 1.2;
   EXPECT_NEAR(evaluate_constraints(over, o).total, 5000 * 0.1 * 0.1, 1e-9);
+}
+
+// 3D landings are measured in the ground plane: within the disc's radius of its centre, at
+// touch-down and at rest; the robot's forward pitch beyond its limit costs K_c d^2.
+TEST(Constraints, LandingDiscAndPitchLimit) {
+  Task t = load_task(kTasks + "robot_jump.toml");
+  MotionSummary m;
+  m.took_off = m.landed = m.settled = true;
+  m.feet_x = m.touchdown_feet_x = 4.3;
+  m.feet_y = m.touchdown_feet_y = 0.4;  // 0.5 m from the centre: inside the 0.75 m disc
+  EXPECT_EQ(evaluate_constraints(t, m).total, 0.0);
+  // The margin is the smallest slack: 0.25 m inside the disc, and 0.7 rad of pitch
+  // counting 0.2 m per rad.
+  EXPECT_NEAR(constraint_margin(t, m), 0.14, 1e-12);
+  m.max_forward_pitch = 0.5;
+  EXPECT_NEAR(constraint_margin(t, m), 0.04, 1e-12);
+  m.max_forward_pitch = 0;
+  m.touchdown_feet_y = 0.8;  // sideways at touch-down: sqrt(0.09 + 0.64) = 0.854 m
+  EXPECT_NEAR(evaluate_constraints(t, m).total, 5000 * std::pow(std::hypot(0.3, 0.8) - 0.75, 2), 1e-9);
+  m.touchdown_feet_y = 0.4;
+  m.max_forward_pitch = 0.9;  // 0.2 rad past the limit
+  const ConstraintReport r = evaluate_constraints(t, m);
+  EXPECT_NEAR(r.total, 5000 * 0.2 * 0.2, 1e-9);
+  EXPECT_EQ(r.terms.back().name, "pitch");
 }
 
 }  // namespace

@@ -1,0 +1,575 @@
+#include "control/jump3d_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/error.h"
+#include "core/toml_reader.h"
+
+namespace diverse {
+namespace {
+
+constexpr const char* kPhaseNames[kNumJumpPhases] = {"start", "crouch", "extend", "rise", "fall", "land"};
+constexpr const char* kGainJoints[3] = {"hip", "knee", "ankle"};
+
+bool is_stance(int phase) { return phase == kStart || phase == kCrouch || phase == kExtend || phase == kLand; }
+
+// World-pitch ranges (rad) of the links tracked in stance: root, foot, chest.
+constexpr double kRootRange[2] = {-1.2, 1.2};
+constexpr double kFootRange[2] = {-1.0, 0.4};
+constexpr double kChestRange[2] = {-1.2, 1.2};
+
+using Vec3 = std::array<double, 3>;
+
+Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec3 add(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+Vec3 scale(const Vec3& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+// Rodrigues: u turned by `angle` about the unit axis a.
+Vec3 turn(const Vec3& a, double angle, const Vec3& u) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return add(add(scale(u, c), scale(cross(a, u), s)), scale(a, dot(a, u) * (1 - c)));
+}
+Vec3 in_frame(const std::array<double, 4>& inv, const std::array<double, 3>& v) {
+  Vec3 out;
+  mju_rotVecQuat(out.data(), v.data(), inv.data());
+  return out;
+}
+
+// The groups a jump3d controller drives, by role.
+struct Layout {
+  int hip = -1, hip_roll = -1, knee = -1, ankle = -1, foot = -1, chest = -1;
+  std::vector<int> posed;  // parameterized groups (sagittal, not neck or wrist)
+};
+
+bool on_feet(const Character& body, const JointGroup& g) {
+  for (int k : g.joints) {
+    const int b = body.joints[static_cast<size_t>(k)].body;
+    if (b != body.feet[0] && b != body.feet[1]) return false;
+  }
+  return true;
+}
+
+Layout layout_of(const Character& body) {
+  Layout l;
+  l.hip = body.find_group(JointRole::kHip, JointPlane::kSagittal);
+  l.hip_roll = body.find_group(JointRole::kHip, JointPlane::kCoronal);
+  l.knee = body.find_group(JointRole::kKnee, JointPlane::kSagittal);
+  l.ankle = body.find_group(JointRole::kAnkle, JointPlane::kSagittal);
+  size_t depth = 0;
+  for (size_t g = 0; g < body.groups.size(); ++g) {
+    const JointGroup& group = body.groups[g];
+    if (group.plane != JointPlane::kSagittal) continue;
+    if (l.foot < 0 && group.joints.size() == 2 && on_feet(body, group)) l.foot = static_cast<int>(g);
+    if (group.role == JointRole::kWaist) {
+      const size_t d = body.chain(group.joints[0]).size();
+      if (l.chest < 0 || d > depth) {
+        l.chest = static_cast<int>(g);
+        depth = d;
+      }
+    }
+    if (group.role != JointRole::kNeck && group.role != JointRole::kWrist) l.posed.push_back(static_cast<int>(g));
+  }
+  return l;
+}
+
+std::string pose_name(int phase, const Character& body, const Layout& l, int group) {
+  std::string name = body.groups[static_cast<size_t>(group)].name;
+  if (is_stance(phase)) {
+    if (group == l.hip) name = body.spec->root_body;
+    if (group == l.foot) name = "foot";
+    if (group == l.chest) name = "chest";
+  }
+  return std::string(kPhaseNames[phase]) + "." + name;
+}
+
+ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group) {
+  const CharacterJoint& j = body.joints[static_cast<size_t>(body.groups[static_cast<size_t>(group)].joints[0])];
+  double lo = j.lower, hi = j.upper;
+  if (!std::isfinite(lo) || !std::isfinite(hi)) {
+    lo = -M_PI;
+    hi = M_PI;
+  }
+  if (is_stance(phase)) {
+    const double* r = group == l.hip ? kRootRange : group == l.foot ? kFootRange : group == l.chest ? kChestRange : nullptr;
+    if (r != nullptr) {
+      lo = r[0];
+      hi = r[1];
+    }
+  }
+  return {pose_name(phase, body, l, group), lo, hi, "rad"};
+}
+
+double clamp_to_range(const CharacterJoint& j, double q) {
+  if (std::isfinite(j.lower) && std::isfinite(j.upper)) return std::clamp(q, j.lower, j.upper);
+  return q;
+}
+
+}  // namespace
+
+HipAngles hip_angles_for(const Vec3& leg, const Vec3& pitch_axis, const Vec3& roll_axis, bool has_roll,
+                         const Vec3& direction) {
+  HipAngles out;
+  const Vec3& u = leg;
+  const Vec3& w = direction;
+  const Vec3& ap = pitch_axis;
+  // Roll first (the pitch, applied after it, keeps every component along its own axis):
+  // make u's component along the pitch axis equal w's. With a the roll axis (orthogonal to
+  // the pitch axis), (R(a, r) u) . ap = A cos r + B sin r, A = u . ap, B = (a x u) . ap.
+  if (has_roll) {
+    const Vec3& ar = roll_axis;
+    const double A = dot(u, ap), B = dot(cross(ar, u), ap), c = dot(w, ap);
+    const double R = std::hypot(A, B);
+    if (R > 1e-12) {
+      const double base = std::atan2(B, A), spread = std::acos(std::clamp(c / R, -1.0, 1.0));
+      const double r1 = std::remainder(base + spread, 2 * M_PI), r2 = std::remainder(base - spread, 2 * M_PI);
+      out.roll = std::fabs(r1) < std::fabs(r2) ? r1 : r2;
+    }
+  }
+  const Vec3 u1 = has_roll ? turn(roll_axis, out.roll, u) : u;
+  // Then the pitch: the turn about the pitch axis from u1 to w, in the plane normal to it.
+  const Vec3 a_perp = sub(u1, scale(ap, dot(u1, ap)));
+  const Vec3 b_perp = sub(w, scale(ap, dot(w, ap)));
+  out.pitch = std::atan2(dot(ap, cross(a_perp, b_perp)), dot(a_perp, b_perp));
+  return out;
+}
+
+std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_height(double height) const {
+  auto c = std::make_shared<Jump3dControllerConfig>(*this);
+  c->landing_height_m = height;
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------
+// The plug-in.
+
+std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const TomlReader& r) const {
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd"});
+  auto c = std::make_shared<Jump3dControllerConfig>();
+  c->landing_control = r.boolean("landing_control", c->landing_control);
+  c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
+  c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
+  c->com_kp = r.number("com_kp", 0, 500, c->com_kp);
+  c->com_kd = r.number("com_kd", 0, 100, c->com_kd);
+  return c;
+}
+
+void Jump3dControllerType::check(const Character& body, const std::string& task_file) const {
+  const std::string who = "the character " + body.spec->file;
+  if (body.root != RootKind::kFree) {
+    throw_field_error(task_file, "controller.type",
+                      "expected a character with a free root for \"jump3d\", but " + who +
+                          " has a planar root (use \"jump2d\")");
+  }
+  for (JointRole role : {JointRole::kHip, JointRole::kKnee, JointRole::kAnkle}) {
+    const int g = body.find_group(role, JointPlane::kSagittal);
+    if (g < 0) {
+      throw_field_error(task_file, "controller.type",
+                        std::string("expected a sagittal joint group with role \"") + to_string(role) +
+                            "\" for \"jump3d\", but " + who + " has none");
+    }
+    if (body.groups[static_cast<size_t>(g)].joints.size() != 2) {
+      throw_field_error(task_file, "controller.type",
+                        std::string("expected a left/right pair in the sagittal \"") + to_string(role) +
+                            "\" group for \"jump3d\" (two legs), in " + who);
+    }
+  }
+  if (layout_of(body).foot < 0) {
+    throw_field_error(task_file, "controller.type",
+                      "expected a sagittal left/right joint group on the foot bodies for \"jump3d\" "
+                      "(the feet's pitch), but " + who + " has none");
+  }
+}
+
+std::vector<ParamSpec> Jump3dControllerType::parameter_specs(const Character& body, const ControllerConfig&) const {
+  return Jump3dController::parameter_specs(body);
+}
+
+std::unique_ptr<Controller> Jump3dControllerType::make(const Character& body, const ControllerConfig& config,
+                                                       const std::vector<double>& values) const {
+  const auto* c = dynamic_cast<const Jump3dControllerConfig*>(&config);
+  if (c == nullptr) throw std::logic_error("jump3d: configuration of another controller");
+  auto controller = std::make_unique<Jump3dController>(body, *c);
+  controller->set_parameters(values);
+  return controller;
+}
+
+// ---------------------------------------------------------------------------------------
+// The controller.
+
+std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body) {
+  const Layout l = layout_of(body);
+  std::vector<ParamSpec> specs;
+  for (int p = 0; p < kNumJumpPhases; ++p) {
+    for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
+    for (int j = 0; j < 3; ++j) {
+      const std::string prefix = std::string(kPhaseNames[p]) + ".";
+      const double kp_hi = j == 2 ? 1500 : 2000;
+      specs.push_back({prefix + "kp_" + kGainJoints[j], 50, kp_hi, "Nm/rad"});
+      specs.push_back({prefix + "kd_" + kGainJoints[j], 2, 200, "Nm s/rad"});
+    }
+  }
+  specs.push_back({"start.duration", 0.05, 0.6, "s"});
+  specs.push_back({"crouch.duration", 0.1, 1.0, "s"});
+  specs.push_back({"land.duration", 0.05, 0.8, "s"});
+  specs.push_back({"crouch.lean", -0.15, 0.15, "m"});
+  specs.push_back({"extend.lean", -0.4, 0.4, "m"});
+  specs.push_back({"land.balance_offset", -0.1, 0.1, "m"});
+  specs.push_back({"landing.offset", -0.4, 0.4, "m"});
+  specs.push_back({"landing.velocity_gain", -0.4, 0.4, "s"});
+  return specs;
+}
+
+Jump3dController::Jump3dController(const Character& body, const Jump3dControllerConfig& config)
+    : body_(body), config_(config) {
+  const Layout l = layout_of(body);
+  hip_ = l.hip;
+  knee_ = l.knee;
+  ankle_ = l.ankle;
+  foot_group_ = l.foot;
+  chest_ = l.chest;
+  posed_ = l.posed;
+  pose_slot_.assign(body.groups.size(), -1);
+  for (size_t k = 0; k < posed_.size(); ++k) pose_slot_[static_cast<size_t>(posed_[k])] = static_cast<int>(k);
+  gain_slot_.assign(body.groups.size(), -1);
+  gain_slot_[static_cast<size_t>(hip_)] = 0;
+  gain_slot_[static_cast<size_t>(knee_)] = 1;
+  gain_slot_[static_cast<size_t>(ankle_)] = 2;
+  for (auto& p : pose_) p.assign(posed_.size(), 0.0);
+  const size_t n = body.joints.size();
+  target_.assign(n, 0.0);
+  flight_from_.assign(n, 0.0);
+  from_.joints.assign(n, 0.0);
+  goal_.joints.assign(n, 0.0);
+  qpos0_.assign(n, 0.0);
+  times_.names.assign(kPhaseNames, kPhaseNames + kNumJumpPhases);
+  times_.begin.assign(kNumJumpPhases, -1.0);
+  times_.rise = kRise;
+  times_.fall = kFall;
+  times_.land = kLand;
+
+  // The legs: hip pitch and roll, and the chain from the hip down to the foot.
+  const int hip_roll = l.hip_roll;
+  for (int s = 0; s < 2; ++s) {
+    LegGeometry& leg = legs_[static_cast<size_t>(s)];
+    leg.hip_pitch = body.groups[static_cast<size_t>(hip_)].joints[static_cast<size_t>(s)];
+    if (hip_roll >= 0 && body.groups[static_cast<size_t>(hip_roll)].joints.size() == 2) {
+      leg.hip_roll = body.groups[static_cast<size_t>(hip_roll)].joints[static_cast<size_t>(s)];
+    }
+  }
+}
+
+void Jump3dController::set_parameters(const std::vector<double>& values) {
+  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 8;
+  if (values.size() != count) throw std::logic_error("Jump3dController: parameter count");
+  size_t k = 0;
+  for (int p = 0; p < kNumJumpPhases; ++p) {
+    for (size_t g = 0; g < posed_.size(); ++g) pose_[static_cast<size_t>(p)][g] = values[k++];
+    for (int j = 0; j < 3; ++j) {
+      kp_[static_cast<size_t>(p)][static_cast<size_t>(j)] = values[k++];
+      kd_[static_cast<size_t>(p)][static_cast<size_t>(j)] = values[k++];
+    }
+  }
+  start_duration_ = values[k++];
+  crouch_duration_ = values[k++];
+  land_duration_ = values[k++];
+  lean_ = values[k++];
+  extend_lean_ = values[k++];
+  land_offset_ = values[k++];
+  landing_offset_ = values[k++];
+  landing_velocity_gain_ = values[k++];
+}
+
+void Jump3dController::reset(const mjModel* m, const mjData* d) {
+  StanceGains gains;
+  gains.com_kp = config_.com_kp;
+  gains.com_kd = config_.com_kd;
+  stance_ = std::make_unique<StanceController>(body_, m, gains);
+  gravity_ = -m->opt.gravity[2];
+  const size_t n = body_.joints.size();
+  for (size_t k = 0; k < n; ++k) qpos0_[k] = m->qpos0[body_.joints[k].qpos];
+  const double* q0 = m->qpos0 + body_.root_qpos + 3;
+  root0_inv_ = {q0[0], -q0[1], -q0[2], -q0[3]};
+  mju_normalize4(root0_inv_.data());
+
+  // Leg geometry at qpos0, in the root's frame.
+  const int foot_group = foot_group_;
+  double middle = 0;
+  std::array<Vec3, 2> foot_point{};
+  for (int s = 0; s < 2; ++s) {
+    LegGeometry& leg = legs_[static_cast<size_t>(s)];
+    const CharacterJoint& hip = body_.joints[static_cast<size_t>(leg.hip_pitch)];
+    const int foot_joint = body_.groups[static_cast<size_t>(foot_group)].joints[static_cast<size_t>(s)];
+    const CharacterJoint& foot = body_.joints[static_cast<size_t>(foot_joint)];
+    leg.pitch0 = m->qpos0[hip.qpos];
+    leg.pitch_axis = in_frame(root0_inv_, hip.axis0);
+    if (leg.hip_roll >= 0) {
+      const CharacterJoint& roll = body_.joints[static_cast<size_t>(leg.hip_roll)];
+      leg.roll0 = m->qpos0[roll.qpos];
+      leg.roll_axis = in_frame(root0_inv_, roll.axis0);
+    }
+    // The joints strictly between the hip's body and the foot's, top down (chain() runs
+    // from the joint's body up to the root).
+    const std::vector<int>& chain = body_.chain(foot_joint);
+    leg.middle.clear();
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(*it)];
+      if (j.body != hip.body && j.body != foot.body) leg.middle.push_back(*it);
+    }
+    leg.middle0.clear();
+    leg.axes.clear();
+    leg.segments.clear();
+    Vec3 from = hip.anchor0;
+    for (int k : leg.middle) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      leg.middle0.push_back(m->qpos0[j.qpos]);
+      leg.axes.push_back(in_frame(root0_inv_, j.axis0));
+      leg.segments.push_back(in_frame(root0_inv_, sub(j.anchor0, from)));
+      from = j.anchor0;
+    }
+    leg.segments.push_back(in_frame(root0_inv_, sub(foot.anchor0, from)));
+    foot_point[static_cast<size_t>(s)] = in_frame(root0_inv_, foot.anchor0);
+    middle += 0.5 * foot_point[static_cast<size_t>(s)][1];
+  }
+  for (int s = 0; s < 2; ++s) legs_[static_cast<size_t>(s)].lateral = foot_point[static_cast<size_t>(s)][1] - middle;
+
+  std::fill(times_.begin.begin(), times_.begin.end(), -1.0);
+  extend_timed_out_ = false;
+  takeoff_com_z_ = 0;
+  free_since_ = -1;
+  for (size_t k = 0; k < n; ++k) target_[k] = d->qpos[body_.joints[k].qpos];
+  stance_->reset(m, d);
+  heading_ = stance_->heading();
+  const int root = body_.root_body;
+  for (int k = 0; k < 3; ++k) com_[static_cast<size_t>(k)] = d->subtree_com[3 * root + k];
+  com_vel_ = {0, 0, 0};
+  enter(kStart, m, d);
+  phase_changed_ = false;
+}
+
+void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
+  const double t = d->time;
+  const int previous = phase_;
+  phase_ = phase;
+  phase_begin_ = t;
+  phase_changed_ = true;
+  times_.begin[static_cast<size_t>(phase)] = t;
+  const size_t n = body_.joints.size();
+  const std::vector<double>& pose = pose_[static_cast<size_t>(phase)];
+
+  if (is_stance(phase)) {
+    if (phase == kLand) stance_->reset(m, d);  // the heading and footing it landed with
+    // Start from where the body is (after reset or flight) or from the targets commanded
+    // so far (from one stance phase to the next).
+    const bool continuing = phase != kStart && phase != kLand && is_stance(previous);
+    if (!continuing) {
+      const StanceController::Pitches p = stance_->measured_pitches(d);
+      from_.root = p.root;
+      from_.torso = p.torso;
+      from_.foot = p.foot;
+      for (size_t k = 0; k < n; ++k) from_.joints[k] = d->qpos[body_.joints[k].qpos];
+    } else {
+      from_ = goal_;
+    }
+    goal_.root = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])];
+    goal_.foot = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(foot_group_)])];
+    goal_.torso = chest_ >= 0 ? pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(chest_)])] : goal_.root;
+    for (size_t k = 0; k < n; ++k) {
+      const int g = body_.joints[k].group;
+      const int slot = pose_slot_[static_cast<size_t>(g)];
+      if (g == hip_ || g == foot_group_ || g == chest_) {
+        goal_.joints[k] = from_.joints[k];  // tracked in the world; held if the leg is off the ground
+      } else {
+        goal_.joints[k] = slot >= 0 ? pose[static_cast<size_t>(slot)] : qpos0_[k];
+      }
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const int gs = gain_slot_[static_cast<size_t>(body_.joints[k].group)];
+      const JointGroup& g = body_.groups[static_cast<size_t>(body_.joints[k].group)];
+      if (gs >= 0) {
+        stance_->set_joint_gains(static_cast<int>(k), kp_[static_cast<size_t>(phase)][static_cast<size_t>(gs)],
+                                 kd_[static_cast<size_t>(phase)][static_cast<size_t>(gs)]);
+      } else {
+        stance_->set_joint_gains(static_cast<int>(k), g.kp, g.kd);
+      }
+    }
+    stance_->set_root_gains(2 * kp_[static_cast<size_t>(phase)][0], 2 * kd_[static_cast<size_t>(phase)][0]);
+    const double h = stance_->heading();
+    const double offset = phase == kLand ? land_offset_ : phase == kExtend ? extend_lean_ : lean_;
+    stance_->set_com_offset(offset * std::cos(h), offset * std::sin(h));
+    stance_->set_com_force(phase == kExtend ? StanceController::ComForce::kPush : StanceController::ComForce::kSupport);
+    switch (phase) {
+      case kStart: phase_duration_ = start_duration_; break;
+      case kCrouch: phase_duration_ = crouch_duration_; break;
+      case kLand: phase_duration_ = land_duration_; break;
+      default: phase_duration_ = 0; break;  // extend: at once
+    }
+    return;
+  }
+
+  // Flight: joint targets, from the pose at take-off or the targets commanded so far.
+  for (size_t k = 0; k < n; ++k) {
+    flight_from_[k] = phase == kRise ? d->qpos[body_.joints[k].qpos] : target_[k];
+    target_[k] = flight_from_[k];
+  }
+  if (phase == kRise) {
+    takeoff_com_z_ = com_[2];
+    phase_duration_ = std::max(com_vel_[2], 0.05) / gravity_;
+  } else {
+    phase_duration_ = std::sqrt(2 * std::max(com_[2] - takeoff_com_z_, 0.01) / gravity_);
+  }
+}
+
+void Jump3dController::landing_hips(const mjData* d, std::vector<double>& targets) const {
+  // Where the COM comes down on its ballistic path to the height it took off at (raised by
+  // the landing surface's height): where the feet meet the ground.
+  const double z = std::max(com_[2] - takeoff_com_z_ - config_.landing_height_m, 0.0);
+  const double vz = com_vel_[2];
+  const double t_cross = (vz + std::sqrt(vz * vz + 2 * gravity_ * z)) / gravity_;
+  const double f[2] = {std::cos(heading_), std::sin(heading_)};
+  const double lat[2] = {-f[1], f[0]};
+  const int root = body_.root_body;
+  std::array<double, 4> root_inv{d->xquat[4 * root], -d->xquat[4 * root + 1], -d->xquat[4 * root + 2],
+                                 -d->xquat[4 * root + 3]};
+  for (int s = 0; s < 2; ++s) {
+    const LegGeometry& leg = legs_[static_cast<size_t>(s)];
+    double goal[2];
+    for (int i = 0; i < 2; ++i) {
+      goal[i] = com_[static_cast<size_t>(i)] + com_vel_[static_cast<size_t>(i)] * t_cross +
+                landing_offset_ * f[i] + landing_velocity_gain_ * com_vel_[static_cast<size_t>(i)] +
+                leg.lateral * lat[i];
+    }
+    // The leg (hip to foot joint) with the joints between at their targets, in the root's
+    // frame with the hip at its reference angles: s0 + R1 (s1 + R2 (s2 + ...)).
+    Vec3 v = leg.segments.back();
+    for (size_t i = leg.middle.size(); i-- > 0;) {
+      const double q = targets[static_cast<size_t>(leg.middle[i])];
+      v = add(leg.segments[i], turn(leg.axes[i], q - leg.middle0[i], v));
+    }
+    const double length = std::sqrt(dot(v, v));
+    if (length < 1e-6) continue;
+    const CharacterJoint& hip = body_.joints[static_cast<size_t>(leg.hip_pitch)];
+    const double* p = d->xanchor + 3 * hip.joint;
+    const double dx = goal[0] - p[0], dy = goal[1] - p[1];
+    const double reach = std::min(std::hypot(dx, dy), 0.9 * length);
+    const double k = std::hypot(dx, dy) > 1e-9 ? reach / std::hypot(dx, dy) : 0;
+    const Vec3 r_world{dx * k, dy * k, -std::sqrt(length * length - reach * reach)};
+    Vec3 w;
+    mju_rotVecQuat(w.data(), r_world.data(), root_inv.data());
+    w = scale(w, 1 / length);
+    const HipAngles a = hip_angles_for(scale(v, 1 / length), leg.pitch_axis, leg.roll_axis, leg.hip_roll >= 0, w);
+    targets[static_cast<size_t>(leg.hip_pitch)] = clamp_to_range(hip, leg.pitch0 + a.pitch);
+    if (leg.hip_roll >= 0) {
+      const CharacterJoint& r = body_.joints[static_cast<size_t>(leg.hip_roll)];
+      targets[static_cast<size_t>(leg.hip_roll)] = clamp_to_range(r, leg.roll0 + a.roll);
+    }
+  }
+}
+
+void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) {
+  const double t = d->time;
+  const int root = body_.root_body;
+  mj_subtreeVel(m, d);
+  for (int k = 0; k < 3; ++k) {
+    com_[static_cast<size_t>(k)] = d->subtree_com[3 * root + k];
+    com_vel_[static_cast<size_t>(k)] = d->subtree_linvel[3 * root + k];
+  }
+
+  // Transitions: at most one per step.
+  phase_changed_ = false;
+  const double elapsed = t - phase_begin_;
+  switch (phase_) {
+    case kStart:
+      if (elapsed >= start_duration_) enter(kCrouch, m, d);
+      break;
+    case kCrouch:
+      if (elapsed >= crouch_duration_) enter(kExtend, m, d);
+      break;
+    case kExtend:
+      if (contacts.any) free_since_ = -1;
+      else if (free_since_ < 0) free_since_ = t;
+      if (free_since_ >= 0 && t - free_since_ >= config_.airborne_time - 1e-9 && com_vel_[2] > 0) {
+        enter(kRise, m, d);
+      } else if (elapsed >= config_.extend_timeout) {
+        extend_timed_out_ = true;
+        enter(kLand, m, d);
+      }
+      break;
+    case kRise:
+      if (contacts.any) {
+        times_.begin[kFall] = t;  // touched down while rising: a zero-length fall
+        enter(kLand, m, d);
+      } else if (com_vel_[2] <= 0) {
+        enter(kFall, m, d);
+      }
+      break;
+    case kFall:
+      if (contacts.any) enter(kLand, m, d);
+      break;
+    default:
+      break;
+  }
+
+  const double s = phase_duration_ > 0 ? std::clamp((t - phase_begin_) / phase_duration_, 0.0, 1.0) : 1.0;
+  const size_t n = body_.joints.size();
+
+  if (is_stance(phase_)) {
+    stance_->set_pitches(from_.root + s * (goal_.root - from_.root), from_.torso + s * (goal_.torso - from_.torso),
+                         from_.foot + s * (goal_.foot - from_.foot));
+    for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
+    stance_->set_targets(target_);
+    stance_->control(m, d, drive);
+    return;
+  }
+
+  // Flight: PD toward the phase's joint targets.
+  const std::vector<double>& pose = pose_[static_cast<size_t>(phase_)];
+  for (size_t k = 0; k < n; ++k) {
+    const int slot = pose_slot_[static_cast<size_t>(body_.joints[k].group)];
+    const double goal = slot >= 0 ? pose[static_cast<size_t>(slot)] : qpos0_[k];
+    target_[k] = flight_from_[k] + s * (goal - flight_from_[k]);
+  }
+  if (phase_ == kFall && config_.landing_control) {
+    // Blend toward the landing placement while the root is within 60 degrees of upright.
+    double up0[3];
+    const double z[3] = {0, 0, 1};
+    mju_rotVecQuat(up0, z, root0_inv_.data());
+    double up[3];
+    mju_mulMatVec(up, d->xmat + 9 * root, up0, 3, 3);
+    const double w = std::clamp((up[2] - 0.5) / 0.5, 0.0, 1.0);
+    if (w > 0) {
+      std::array<double, 4> hips{};
+      for (int side = 0; side < 2; ++side) {
+        const LegGeometry& leg = legs_[static_cast<size_t>(side)];
+        hips[static_cast<size_t>(2 * side)] = target_[static_cast<size_t>(leg.hip_pitch)];
+        hips[static_cast<size_t>(2 * side + 1)] = leg.hip_roll >= 0 ? target_[static_cast<size_t>(leg.hip_roll)] : 0;
+      }
+      landing_hips(d, target_);
+      for (int side = 0; side < 2; ++side) {
+        const LegGeometry& leg = legs_[static_cast<size_t>(side)];
+        double& pitch = target_[static_cast<size_t>(leg.hip_pitch)];
+        pitch = (1 - w) * hips[static_cast<size_t>(2 * side)] + w * pitch;
+        if (leg.hip_roll >= 0) {
+          double& roll = target_[static_cast<size_t>(leg.hip_roll)];
+          roll = (1 - w) * hips[static_cast<size_t>(2 * side + 1)] + w * roll;
+        }
+      }
+    }
+  }
+  const auto& kp = kp_[static_cast<size_t>(phase_)];
+  const auto& kd = kd_[static_cast<size_t>(phase_)];
+  for (size_t k = 0; k < n; ++k) {
+    const CharacterJoint& j = body_.joints[k];
+    const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
+    const int gs = gain_slot_[static_cast<size_t>(j.group)];
+    const double p = gs >= 0 ? kp[static_cast<size_t>(gs)] : g.kp;
+    const double v = gs >= 0 ? kd[static_cast<size_t>(gs)] : g.kd;
+    drive.set(static_cast<int>(k), p * (target_[k] - d->qpos[j.qpos]), v);
+  }
+}
+
+}  // namespace diverse

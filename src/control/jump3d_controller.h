@@ -1,0 +1,190 @@
+// "jump3d": the phase-based jump controller for characters with a free root (the 3D human,
+// the bird robot), the 3D counterpart of "jump2d" (control/jump_controller.h) with the same
+// phases and events, registered in control/builtin_controllers.cc.
+//
+//   start   stance: balance, the COM held `crouch.lean` ahead of the soles' centre,
+//           targets interpolated over start.duration
+//   crouch  stance, the same, over crouch.duration
+//   extend  stance, the targets applied at once with the phase's gains, the COM driven
+//           toward `extend.lean` from the soles' centre (the force not held to the support
+//           polygon: the feet may tip): the legs push; ends when the
+//           character is airborne (no contact for airborne_time, COM rising), or gives
+//           up after extend_timeout
+//   rise    flight, ends at peak height; duration predicted as v_z / g at take-off
+//   fall    flight, ends at the first contact; duration predicted ballistically; the
+//           landing controller places the feet (below)
+//   land    stance: balance over the feet, targets interpolated over land.duration
+//
+// Stance phases run stance control (control/stance_controller.h): Jacobian-transpose
+// virtual forces on the COM in both horizontal directions (and F_z = M g, without a height
+// servo, so the joint targets decide how low the body goes), realized as joint torques of
+// the stance legs, which also hold the root's world orientation; the torso and the feet
+// track world orientations, everything else is PD. The free parameters of a stance phase
+// are, per sagittal group, a world pitch about the heading's lateral axis (rad, positive
+// backwards, 0 = standing) for the three tracked links:
+//   ROOT (the root body's name: "pelvis", "torso")  the hip group's value,
+//   "foot"   the value of the sagittal group on the foot bodies (ankle, or the bird's toe),
+//   "chest"  the topmost sagittal waist group's value (the torso),
+// and a joint angle for every other sagittal group (knee, the bird's ankle, shoulder,
+// elbow). In flight every value is a joint angle. The sagittal groups of role neck and
+// wrist are not parameters (they hold the standing pose), and neither are the coronal
+// hinges: in stance the stance legs' J^T and the feet's world tracking keep the feet
+// under the body, in flight they hold the standing pose, and in fall the landing
+// controller sets the hips' roll.
+//
+// Gains. Each phase has kp, kd for the hips, the knees and the ankles (the sagittal groups
+// of these roles): PD gains of those joints in flight and for the knees and ankles in
+// stance (for a foot joint, the gains of the foot's world tracking); in stance the hips
+// act through the root's orientation servo, whose gains are twice the hips' (two legs).
+// Every other joint uses the character file's default gains.
+//
+// Landing controller (fall, while the root is within 60 degrees of upright). Each foot is
+// placed at x_c + landing.offset f + landing.velocity_gain v + w_s l, with x_c where the
+// COM is predicted to come down ballistically to its take-off height (plus the landing
+// surface's height), v the COM's horizontal
+// velocity, f and l the heading's forward and lateral axes and w_s the foot's standing
+// lateral offset. The hip's pitch and roll angles that point the leg there come from the
+// leg's geometry at the model's standing pose with the knee at its phase target, solved
+// exactly for a universal hip with orthogonal axes.
+//
+// No external force is ever applied: the root is unactuated and every torque goes through
+// the joint drive (physics/drive.h), which keeps it within the joint's limit on the net
+// torque.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "character/character.h"
+#include "control/controller.h"
+#include "control/jump_controller.h"
+#include "control/parameters.h"
+#include "control/stance_controller.h"
+
+namespace diverse {
+
+// The hip angles that point a leg in a given direction, for a hip of two orthogonal hinges
+// (pitch, then roll; `has_roll` false: pitch only). All vectors in one frame (the root's);
+// `leg` is the unit vector from the hip to the foot with both hip angles at their reference
+// (qpos0) values, `direction` the unit vector the leg should point along. Returns the
+// angles to add to the references, the roll nearest 0 of the two exact solutions; a
+// direction the hip cannot reach exactly (roll alone limits the component along the pitch
+// axis) gets the nearest one.
+struct HipAngles {
+  double pitch = 0, roll = 0;
+};
+HipAngles hip_angles_for(const std::array<double, 3>& leg, const std::array<double, 3>& pitch_axis,
+                         const std::array<double, 3>& roll_axis, bool has_roll,
+                         const std::array<double, 3>& direction);
+
+// Constants that are not optimized (documented defaults; the task file may override).
+struct Jump3dControllerConfig : ControllerConfig {
+  bool landing_control = true;   // place the feet during fall
+  double landing_height_m = 0;   // m, height of the surface the COM prediction uses
+  double extend_timeout = 0.8;   // s; an extend that never leaves the ground ends here
+  double airborne_time = 0.01;   // s without contact (COM rising) that counts as take-off
+  double com_kp = 40, com_kd = 12;  // 1/s^2, 1/s: the stance phases' horizontal COM servo
+
+  std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
+  double landing_height() const override { return landing_height_m; }
+};
+
+class Jump3dControllerType : public ControllerType {
+ public:
+  const char* name() const override { return "jump3d"; }
+  const char* description() const override {
+    return "phase-based jump of a character with a free root (start, crouch, extend, rise, fall, land)";
+  }
+  std::shared_ptr<const ControllerConfig> read_config(const TomlReader& r) const override;
+  void check(const Character& body, const std::string& task_file) const override;
+  std::vector<ParamSpec> parameter_specs(const Character& body,
+                                         const ControllerConfig& config) const override;
+  std::unique_ptr<Controller> make(const Character& body, const ControllerConfig& config,
+                                   const std::vector<double>& values) const override;
+};
+
+class Jump3dController : public Controller {
+ public:
+  Jump3dController(const Character& body, const Jump3dControllerConfig& config);
+
+  // The free parameters for `body`: per phase a value per parameterized group and kp, kd
+  // of hips, knees and ankles; then the durations, the leans of crouch and extend, the
+  // landing balance offset and the landing controller's offset and velocity gain (80 for
+  // the 3D human, 68 for the bird robot).
+  static std::vector<ParamSpec> parameter_specs(const Character& body);
+  void set_parameters(const std::vector<double>& values);
+
+  void reset(const mjModel* m, const mjData* d) override;
+  void control(const mjModel* m, mjData* d, const ContactState& contacts,
+               JointDrive& drive) override;
+
+  int phase() const override { return phase_; }
+  bool phase_changed() const override { return phase_changed_; }
+  const PhaseTimes& phase_times() const override { return times_; }
+  bool gave_up() const override { return extend_timed_out_; }
+  const std::array<double, 3>& com() const override { return com_; }
+  const std::array<double, 3>& com_velocity() const override { return com_vel_; }
+
+ private:
+  // What a stance phase interpolates: the three world pitches, then one joint target per
+  // Character::joints entry.
+  struct StanceTargets {
+    double root = 0, torso = 0, foot = 0;
+    std::vector<double> joints;
+  };
+  // A leg at the model's qpos0, in the root's frame: the hip, then the joints between the
+  // hip and the foot (the knee; the bird's ankle), top down, and the foot's joint.
+  struct LegGeometry {
+    int hip_pitch = -1, hip_roll = -1;            // Character::joints indices (-1: none)
+    double pitch0 = 0, roll0 = 0;                 // their qpos0 values (rad)
+    std::array<double, 3> pitch_axis{}, roll_axis{};
+    std::vector<int> middle;                      // joints between hip and foot, top down
+    std::vector<double> middle0;                  // their qpos0 values
+    std::vector<std::array<double, 3>> axes;      // their axes
+    std::vector<std::array<double, 3>> segments;  // hip -> first, ..., last -> foot joint
+    double lateral = 0;  // m, the foot's standing offset along the root's y from the feet's middle
+  };
+
+  void enter(int phase, const mjModel* m, const mjData* d);
+  void measure_pitches(const mjData* d, StanceTargets& out) const;
+  void landing_hips(const mjData* d, std::vector<double>& targets) const;
+
+  const Character& body_;
+  Jump3dControllerConfig config_;
+  int hip_ = -1, knee_ = -1, ankle_ = -1, foot_group_ = -1, chest_ = -1;  // group indices
+  std::vector<int> posed_;       // parameterized groups, in parameter order
+  std::vector<int> pose_slot_;   // per group: index into posed_, or -1
+  std::vector<int> gain_slot_;   // per group: 0 hip, 1 knee, 2 ankle, -1 default gains
+
+  // Parameters unpacked.
+  std::array<std::vector<double>, kNumJumpPhases> pose_{};
+  std::array<std::array<double, 3>, kNumJumpPhases> kp_{}, kd_{};
+  double start_duration_ = 0.2, crouch_duration_ = 0.4, land_duration_ = 0.3;
+  double lean_ = 0, extend_lean_ = 0, land_offset_ = 0, landing_offset_ = 0, landing_velocity_gain_ = 0;
+
+  // Set at reset() from the model.
+  std::unique_ptr<StanceController> stance_;
+  std::array<LegGeometry, 2> legs_{};
+  std::array<double, 4> root0_inv_{1, 0, 0, 0};  // inverse of the root's qpos0 orientation
+  std::vector<double> qpos0_;                     // per joint: its qpos0 value
+  double gravity_ = 9.81;
+
+  int phase_ = kStart;
+  bool phase_changed_ = false;
+  bool extend_timed_out_ = false;
+  double phase_begin_ = 0, phase_duration_ = 1;
+  double takeoff_com_z_ = 0;
+  double free_since_ = -1;
+  double heading_ = 0;  // rad, the jump's heading (the root's yaw at reset)
+  PhaseTimes times_;
+  StanceTargets from_, goal_;     // stance phases: interpolation ends
+  std::vector<double> target_;    // per joint: last commanded joint target (flight)
+  std::vector<double> flight_from_;
+  std::array<double, 3> com_{}, com_vel_{};
+};
+
+}  // namespace diverse
