@@ -10,8 +10,6 @@
 namespace diverse {
 namespace {
 
-constexpr const char* kPhaseNames[kNumJumpPhases] = {"start", "crouch", "extend", "rise", "fall", "land"};
-constexpr const char* kGainJoints[3] = {"hip", "knee", "ankle"};
 
 bool is_stance(int phase) { return phase == kStart || phase == kCrouch || phase == kExtend || phase == kLand; }
 
@@ -84,7 +82,7 @@ std::string pose_name(int phase, const Character& body, const Layout& l, int gro
     if (group == l.foot) name = "foot";
     if (group == l.chest) name = "chest";
   }
-  return std::string(kPhaseNames[phase]) + "." + name;
+  return std::string(jump_phase_name(phase)) + "." + name;
 }
 
 ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group) {
@@ -206,12 +204,7 @@ std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body) 
   std::vector<ParamSpec> specs;
   for (int p = 0; p < kNumJumpPhases; ++p) {
     for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
-    for (int j = 0; j < 3; ++j) {
-      const std::string prefix = std::string(kPhaseNames[p]) + ".";
-      const double kp_hi = j == 2 ? 1500 : 2000;
-      specs.push_back({prefix + "kp_" + kGainJoints[j], 50, kp_hi, "Nm/rad"});
-      specs.push_back({prefix + "kd_" + kGainJoints[j], 2, 200, "Nm s/rad"});
-    }
+    append_jump_gain_specs(p, specs);
   }
   specs.push_back({"start.duration", 0.05, 0.6, "s"});
   specs.push_back({"crouch.duration", 0.1, 1.0, "s"});
@@ -246,7 +239,7 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
   from_.joints.assign(n, 0.0);
   goal_.joints.assign(n, 0.0);
   qpos0_.assign(n, 0.0);
-  times_.names.assign(kPhaseNames, kPhaseNames + kNumJumpPhases);
+  times_.names = jump_phase_names();
   times_.begin.assign(kNumJumpPhases, -1.0);
   times_.rise = kRise;
   times_.fall = kFall;

@@ -81,6 +81,17 @@ ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group
 
 }  // namespace
 
+void append_jump_gain_specs(int phase, std::vector<ParamSpec>& specs) {
+  const std::string prefix = std::string(kPhaseNames[phase]) + ".";
+  for (int j = 0; j < 3; ++j) {
+    const double kp_hi = j == 2 ? 1500 : 2000;
+    specs.push_back({prefix + "kp_" + kGainJoints[j], 50, kp_hi, "Nm/rad"});
+    specs.push_back({prefix + "kd_" + kGainJoints[j], 2, 200, "Nm s/rad"});
+  }
+}
+
+std::vector<std::string> jump_phase_names() { return {kPhaseNames, kPhaseNames + kNumJumpPhases}; }
+
 const char* jump_phase_name(int phase) {
   return (phase >= 0 && phase < kNumJumpPhases) ? kPhaseNames[phase] : "?";
 }
@@ -151,12 +162,7 @@ std::vector<ParamSpec> JumpController::parameter_specs(const Character& body) {
   std::vector<ParamSpec> specs;
   for (int p = 0; p < kNumJumpPhases; ++p) {
     for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
-    for (int j = 0; j < 3; ++j) {
-      const std::string prefix = std::string(kPhaseNames[p]) + ".";
-      const double kp_hi = j == 2 ? 1500 : 2000;
-      specs.push_back({prefix + "kp_" + kGainJoints[j], 50, kp_hi, "Nm/rad"});
-      specs.push_back({prefix + "kd_" + kGainJoints[j], 2, 200, "Nm s/rad"});
-    }
+    append_jump_gain_specs(p, specs);
   }
   specs.push_back({"start.duration", 0.05, 0.6, "s"});
   specs.push_back({"crouch.duration", 0.1, 1.0, "s"});
@@ -203,7 +209,7 @@ JumpController::JumpController(const Character& body, const JumpControllerConfig
   from_.assign(body.joints.size(), 0.0);
   target_.assign(body.joints.size(), 0.0);
   balance_.assign(body.joints.size(), 0.0);
-  times_.names.assign(kPhaseNames, kPhaseNames + kNumJumpPhases);
+  times_.names = jump_phase_names();
   times_.begin.assign(kNumJumpPhases, -1.0);
   times_.rise = kRise;
   times_.fall = kFall;

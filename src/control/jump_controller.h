@@ -64,6 +64,11 @@ namespace diverse {
 
 enum JumpPhase : int { kStart = 0, kCrouch, kExtend, kRise, kFall, kLand, kNumJumpPhases };
 const char* jump_phase_name(int phase);  // "start", "crouch", ...
+// The phase gains every jump controller optimizes: PHASE.kp_hip, PHASE.kd_hip, ..., of
+// hips, knees and ankles, appended to `specs` (shared by jump2d and jump3d).
+void append_jump_gain_specs(int phase, std::vector<ParamSpec>& specs);
+// The six phase names, in order, for PhaseTimes::names.
+std::vector<std::string> jump_phase_names();
 
 // Constants that are not optimized (documented defaults; the task file may override).
 struct JumpControllerConfig : ControllerConfig {
