@@ -29,8 +29,11 @@ const std::string kArgs = kTask +
                           " --n 2 --popsize 8 --sigma0 0.03 --generations 4 --seed 3 --threads 1 "
                           "--checkpoint-seconds 0 --quiet --no-render";
 
+// One directory per process and name: CTest runs each test of this file as its own
+// process, several at once, and every one of them builds the reference run first.
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_faults_test_" + name);
+  const fs::path dir =
+      fs::temp_directory_path() / ("diverse_faults_test_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(dir);
   return dir;
 }
@@ -84,7 +87,11 @@ class Faults : public ::testing::Test {
     const cli_test::CliResult r = cli_test::run_cli("run " + kArgs + " --out " + reference_->string());
     ASSERT_EQ(r.status, 0) << r.output;
   }
-  static void TearDownTestSuite() { delete reference_; }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(*reference_, ec);
+    delete reference_;
+  }
   static nlohmann::json reference_summary() { return without_timing(read_json(*reference_ / "summary.json")); }
 
   static void expect_resumes_to_reference(const fs::path& dir) {
