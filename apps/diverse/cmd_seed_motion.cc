@@ -36,7 +36,17 @@ struct SeedArgs {
   bool robustness_check = false;
   std::vector<double> check_sigmas{0.02, 0.05};
   int check_samples = 32;
+  int from_stage = 0;
 };
+
+// "tasks/x.m0.json" -> "tasks/x"; "a/b.json" -> "a/b".
+std::string output_stem(const std::string& path) {
+  for (const std::string suffix : {".m0.json", ".json"}) {
+    if (path.size() > suffix.size() && path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return path.substr(0, path.size() - suffix.size());
+  }
+  return path;
+}
 
 void check(const SeedArgs& args) {
   const Task task = load_task(resolve_task_path(args.task));
@@ -76,22 +86,32 @@ void run(const SeedArgs& args) {
   options.perturbations = args.perturbations;
   options.perturbation_sigma = args.perturbation_sigma;
   options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
+  options.first_stage = args.from_stage;
   options.log = [](const std::string& line) { std::printf("%s\n", line.c_str()); std::fflush(stdout); };
+  const std::string m0_path = args.out.empty() ? task.m0 : args.out;
+  const std::string stem = output_stem(m0_path);
+  // Every continuation stage's result is kept, so a long search that is stopped goes on
+  // with --start <stem>.stage<k>.json --from-stage <k+1>.
+  options.on_stage = [&](int stage, double value, const ParameterSet& p, double constraint) {
+    nlohmann::json j;
+    j["task"] = task.name;
+    j["stage"] = stage;
+    j["stage_value"] = value;
+    j["constraint"] = constraint;
+    j["continue_with"] = "diverse seed-motion " + args.task + " --start " + stem + ".stage" +
+                         std::to_string(stage) + ".json --from-stage " + std::to_string(stage + 1);
+    j["parameters"] = p.to_json();
+    const std::string path = stem + ".stage" + std::to_string(stage) + ".json";
+    write_json_atomic(path, j);
+    std::printf("stage %d ends with C=%.6g -> %s\n", stage, constraint, path.c_str());
+    std::fflush(stdout);
+  };
   const SeedResult r = seed_motion(task, start, options);
   // The task's m0 file only ever holds a motion that meets the task; a search that falls
   // short writes its best attempt beside it, to continue from with --start. With
   // perturbations, a robust near miss that ranks above the motion that meets the task is
   // written there too: it is the better place to continue from.
   const bool met = r.constraint == 0;
-  const std::string m0_path = args.out.empty() ? task.m0 : args.out;
-  const std::string suffix = ".m0.json";
-  const std::string stem =
-      m0_path.size() > suffix.size() &&
-              m0_path.compare(m0_path.size() - suffix.size(), suffix.size(), suffix) == 0
-          ? m0_path.substr(0, m0_path.size() - suffix.size())
-          : (m0_path.size() > 5 && m0_path.compare(m0_path.size() - 5, 5, ".json") == 0
-                 ? m0_path.substr(0, m0_path.size() - 5)
-                 : m0_path);
   const std::string partial_path = stem + ".partial.json";
   // The command as the user gave it: --start only when it was given (the task's [seed]
   // base otherwise, named relative to the task file).
@@ -109,6 +129,7 @@ void run(const SeedArgs& args) {
     command += " --perturbations " + std::to_string(args.perturbations) +
                " --perturbation-sigma " + sigma;
   }
+  if (args.from_stage > 0) command += " --from-stage " + std::to_string(args.from_stage);
   if (args.min_flight_rotation_deg > 0) {
     char deg[32];
     std::snprintf(deg, sizeof(deg), "%g", args.min_flight_rotation_deg);
@@ -170,6 +191,10 @@ void install(CLI::App& app) {
                   "Require this root rotation (degrees, backwards positive) between take-off and "
                   "touch-down while searching (0 = none)")
       ->check(number_in(0, 720));
+  cmd->add_option("--from-stage", args->from_stage,
+                  "Start at this continuation stage (0 = the first); every stage's result is "
+                  "written to <m0 stem>.stage<k>.json to go on from")
+      ->check(integer_in(0, 100));
   cmd->add_flag("--robustness-check", args->robustness_check,
                 "Measure a motion instead of searching (default: the task's M0, or --start)");
   cmd->add_option("--check-sigmas", args->check_sigmas,

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/error.h"
 #include "core/rng.h"
 #include "core/thread_pool.h"
 #include "optimize/cmaes.h"
@@ -186,7 +187,12 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   ThreadPool pool(std::max(1, options.threads));
   char line[320];
 
-  for (size_t stage = 0; stage < heights.size(); ++stage) {
+  if (options.first_stage < 0 || static_cast<size_t>(options.first_stage) >= heights.size()) {
+    throw UserError(task.file + ": --from-stage: expected a stage from 0 to " +
+                    std::to_string(heights.size() - 1) + " (got " + std::to_string(options.first_stage) + ")");
+  }
+
+  for (size_t stage = static_cast<size_t>(options.first_stage); stage < heights.size(); ++stage) {
     const bool last = stage + 1 == heights.size();
     const Task stage_task = by_distance        ? with_distance(task, heights[stage])
                             : heights[stage] < 0 ? task
@@ -229,7 +235,16 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       result.lowest_mean_f = best.f;
       result.lowest_mean_meets = best.meets();
     }
-    if (!last && best.meets()) continue;
+    auto hand_on = [&](const Eigen::VectorXd& handed, double constraint) {
+      if (last || !options.on_stage) return;
+      ParameterSet p = start;
+      p.set_normalized(handed);
+      options.on_stage(static_cast<int>(stage), heights[stage], p, constraint);
+    };
+    if (!last && best.meets()) {
+      hand_on(x, best.constraint);
+      continue;
+    }
 
     CmaesOptions co;
     co.dim = static_cast<int>(x.size());
@@ -286,6 +301,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       if (last && best.meets() && since_improvement >= kPatience) break;
     }
     x = have_valid ? best_valid_x : best_x;
+    hand_on(x, have_valid ? best_valid.constraint : best.constraint);
     if (last) {
       result.lowest_mean.set_normalized(best_x);
       result.lowest_mean_f = best.f;

@@ -69,8 +69,16 @@ struct SeedOptions {
   // backwards positive) between take-off and touch-down, else K_c d^2 is added to C for
   // a shortfall of d. 0 = none. Makes a backflip turn in the air rather than on the ground.
   double min_flight_rotation = 0;
+  // Continuation stages before this one are skipped: the search starts at stage
+  // `first_stage` from the starting parameters (a stage file written by `on_stage`).
+  int first_stage = 0;
   // Called after every generation with a one-line progress report.
   std::function<void(const std::string&)> log;
+  // Called at the end of every continuation stage (before the last) with the stage's
+  // index, its landing distance or object height, and the parameters it hands on (the
+  // best that meets the stage's task, or the lowest objective), and their C. A long
+  // search that is stopped can go on from there (first_stage).
+  std::function<void(int stage, double value, const ParameterSet& parameters, double constraint)> on_stage;
 };
 
 struct SeedResult {

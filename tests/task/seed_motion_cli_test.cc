@@ -2,6 +2,7 @@
 // that falls short writes its best attempt beside it and says how to continue. With
 // --robustness-check it measures a motion and its neighbourhood instead of searching.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
@@ -37,6 +38,51 @@ TEST(SeedMotionCli, AShortSearchThatFailsWritesAPartialFileNotTheM0) {
   EXPECT_NE(r.output.find("no motion meeting the task was found"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--start " + (dir / "short.partial.json").string()), std::string::npos)
       << r.output;
+}
+
+// A continuation over landing distances keeps every stage's result, and a search can
+// start at a later stage from it.
+TEST(SeedMotionCli, EveryStageIsKeptAndASearchGoesOnFromALaterStage) {
+  const fs::path dir = fs::temp_directory_path() / ("diverse_seed_motion_cli_test_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string source = DIVERSE_SOURCE_DIR;
+  // Stage 0 lands near where jump_high's input motion lands (0.13 m), which it meets at
+  // once; stage 1 asks for 1 m, which one generation does not reach.
+  write_file_atomic(dir / "far.toml",
+                    "name = \"far\"\n"
+                    "character = \"" + source + "/assets/characters/human2d.xml\"\n"
+                    "metric = \"md\"\n"
+                    "variations = 4\n"
+                    "m0 = \"far.m0.json\"\n"
+                    "[controller]\ntype = \"jump2d\"\n"
+                    "[constraints]\nweight = 5000.0\nfall_penalty = 100000.0\nlanding = { center = 1.0, half_width = 0.15 }\n"
+                    "[seed]\nbase = \"" + source + "/tasks/jump_high.m0.json\"\ngenerations = 1\ndistances = [0.1, 1.0]\n");
+  const std::string task = (dir / "far.toml").string();
+  const auto first = cli_test::run_cli("seed-motion " + task + " --threads 2");
+  EXPECT_NE(first.status, 0) << first.output;
+  const fs::path stage0 = dir / "far.stage0.json";
+  ASSERT_TRUE(fs::exists(stage0)) << first.output;
+  EXPECT_NE(first.output.find("stage 0 ends with C=0 -> " + stage0.string()), std::string::npos) << first.output;
+  const nlohmann::json j = read_json(stage0);
+  EXPECT_EQ(j["stage"], 0);
+  EXPECT_DOUBLE_EQ(j["stage_value"].get<double>(), 0.1);
+  EXPECT_EQ(j["constraint"].get<double>(), 0.0);
+  EXPECT_EQ(j["continue_with"], "diverse seed-motion " + task + " --start " + (dir / "far").string() +
+                                    ".stage0.json --from-stage 1");
+  EXPECT_FALSE(fs::exists(dir / "far.stage1.json")) << "the last stage is the task: its result is the m0 or partial file";
+
+  // Going on from stage 1 skips stage 0.
+  const auto second = cli_test::run_cli("seed-motion " + task + " --start " + stage0.string() + " --from-stage 1");
+  EXPECT_EQ(second.output.find("stage 0"), std::string::npos) << second.output;
+  EXPECT_NE(second.output.find("stage 1 (landing at 1.000 m)"), std::string::npos) << second.output;
+  EXPECT_NE(read_json(dir / "far.partial.json")["found_by"].get<std::string>().find("--from-stage 1"),
+            std::string::npos);
+
+  const auto beyond = cli_test::run_cli("seed-motion " + task + " --from-stage 2");
+  EXPECT_EQ(beyond.status, 2) << beyond.output;
+  EXPECT_NE(beyond.output.find(task + ": --from-stage: expected a stage from 0 to 1 (got 2)"), std::string::npos)
+      << beyond.output;
 }
 
 TEST(SeedMotionCli, RobustnessCheckReportsBothTimestepsAndTheNeighbourhood) {
