@@ -140,8 +140,14 @@ std::string film_title(const std::string& prefix, const std::vector<std::string>
 std::vector<GroundStrip> task_ground_strips(const Task& task) {
   std::vector<GroundStrip> strips;
   const TaskConstraints& c = task.constraints;
-  if (c.landing)
+  if (c.landing && c.landing_radius > 0) {
+    GroundStrip disc{c.landing_center - c.landing_radius, c.landing_center + c.landing_radius};
+    disc.radius = c.landing_radius;
+    disc.y = c.landing_lateral;
+    strips.push_back(disc);
+  } else if (c.landing) {
     strips.push_back({c.landing_center - c.landing_half_width, c.landing_center + c.landing_half_width});
+  }
   return strips;
 }
 

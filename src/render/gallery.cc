@@ -507,7 +507,14 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                        {"frames", body_frames_json(m.model->get(), sampled[i])}});
   }
   nlohmann::json strips = nlohmann::json::array();
-  for (const GroundStrip& g : run.ground_strips) strips.push_back({round4(g.x_min), round4(g.x_max)});
+  // [x0, x1] along the track, or [x0, x1, y, radius] for a disc centred between x0 and x1.
+  for (const GroundStrip& g : run.ground_strips) {
+    if (g.radius > 0) {
+      strips.push_back({round4(g.x_min), round4(g.x_max), round4(g.y), round4(g.radius)});
+    } else {
+      strips.push_back({round4(g.x_min), round4(g.x_max)});
+    }
+  }
   data["scene"] = {{"strips", strips}};
   data["motions"] = motions;
   data["distances"] = s.contains("distances") ? s["distances"] : nlohmann::json::object();

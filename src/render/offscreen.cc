@@ -176,8 +176,10 @@ SideCamera fit_shared_camera(std::span<const PosedModel> motions, double aspect,
   if (floor) bounds.add({bounds.lo[0], y, *floor});
   const double strip_z = floor.value_or(bounds.lo[2]);
   for (const GroundStrip& strip : ground_strips) {
-    bounds.add({strip.x_min, y, strip_z});
-    bounds.add({strip.x_max, y, strip_z});
+    const double y0 = strip.radius > 0 ? strip.y - strip.radius : y;
+    const double y1 = strip.radius > 0 ? strip.y + strip.radius : y;
+    bounds.add({strip.x_min, y0, strip_z});
+    bounds.add({strip.x_max, y1, strip_z});
   }
   return fit_side_camera(bounds, aspect, direction, margin);
 }
@@ -229,6 +231,21 @@ struct OffscreenRenderer::Impl {
     const mjtNum pos[3] = {0.5 * (x0 + x1), 0.5 * (y0 + y1), z_top - 0.5 * kBandThickness};
     const float rgba[4] = {color.r / 255.0f, color.g / 255.0f, color.b / 255.0f, 1.0f};
     mjv_initGeom(geom, mjGEOM_BOX, size, pos, nullptr, rgba);
+    geom->category = mjCAT_DECOR;
+    geom->emission = emission;
+    geom->specular = 0.0f;
+    geom->reflectance = 0.0f;
+  }
+
+  // A flat disc on the floor, its top at z_top.
+  void add_disc(double x, double y, double radius, double z_top, Rgb color, float emission) {
+    if (scene.ngeom >= scene.maxgeom) return;
+    mjvGeom* geom = scene.geoms + scene.ngeom++;
+    // mjv_initGeom reads a cylinder's size as the model does: radius, half-height.
+    const mjtNum size[3] = {radius, 0.5 * kBandThickness, 0};
+    const mjtNum pos[3] = {x, y, z_top - 0.5 * kBandThickness};
+    const float rgba[4] = {color.r / 255.0f, color.g / 255.0f, color.b / 255.0f, 1.0f};
+    mjv_initGeom(geom, mjGEOM_CYLINDER, size, pos, nullptr, rgba);
     geom->category = mjCAT_DECOR;
     geom->emission = emission;
     geom->specular = 0.0f;
@@ -287,8 +304,13 @@ struct OffscreenRenderer::Impl {
       }
     }
     for (const GroundStrip& strip : strips) {
-      add_box(strip.x_min, strip.x_max, cy - std::max(track, 0.5), cy + std::max(track, 0.5),
-              z + 2.0 * kBandThickness, strip.color, emission);
+      if (strip.radius > 0) {
+        add_disc(0.5 * (strip.x_min + strip.x_max), strip.y, strip.radius, z + 2.0 * kBandThickness, strip.color,
+                 emission);
+      } else {
+        add_box(strip.x_min, strip.x_max, cy - std::max(track, 0.5), cy + std::max(track, 0.5),
+                z + 2.0 * kBandThickness, strip.color, emission);
+      }
     }
   }
 

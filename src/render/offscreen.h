@@ -95,11 +95,15 @@ struct PosedModel {
   std::span<const std::vector<double>> frames;  // each a qpos of size model->nq
 };
 
-// A coloured interval of the floor along world x, e.g. a landing region.
+// A coloured interval of the floor along world x, e.g. a landing region; or, with
+// radius > 0, a disc of that radius centred at ((x_min + x_max) / 2, y) (a landing
+// point with a radius, as 3D tasks have).
 struct GroundStrip {
   double x_min = 0.0;  // m, world x
   double x_max = 0.0;  // m, world x
   Rgb color{96, 180, 96};
+  double radius = 0.0;  // m; > 0: a disc
+  double y = 0.0;       // m, world y of the disc's centre
 };
 
 // The camera shared by every picture of a set of motions: fitted to all their poses, the

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include "render/image.h"
 #include "render/run_media.h"
 #include "support/stance_run.h"
+#include "task/task.h"
 
 namespace diverse {
 namespace {
@@ -160,6 +162,60 @@ TEST(FollowingFilmStrip, KeepsAFifteenMetreWalkerLargeInEveryTile) {
   const Image fixed = render_film_strip(rows, options);
   write_png((out_dir() / "fixed.png").string(), fixed);
   EXPECT_LT(character_height_fraction(fixed, x0, y0, 160, 160), 0.25);
+}
+
+// Green pixels of a picture (the ground strips' colour): count and bounding box.
+struct GreenArea {
+  int count = 0, x0 = 1 << 20, x1 = -1, y0 = 1 << 20, y1 = -1;
+};
+GreenArea green_area(const Image& image) {
+  GreenArea a;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const Rgb p = image.pixel(x, y);
+      if (p.g < p.r + 40 || p.g < p.b + 40) continue;
+      ++a.count;
+      a.x0 = std::min(a.x0, x);
+      a.x1 = std::max(a.x1, x);
+      a.y0 = std::min(a.y0, y);
+      a.y1 = std::max(a.y1, y);
+    }
+  }
+  return a;
+}
+
+// A 3D task's landing point with a radius is drawn as a disc there, not as a strip across
+// the track.
+TEST(GroundStrips, A3dLandingPointIsADiscOnTheFloor) {
+  const Task task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_backwards.toml");
+  const std::vector<GroundStrip> strips = task_ground_strips(task);
+  ASSERT_EQ(strips.size(), 1u);
+  EXPECT_DOUBLE_EQ(strips[0].radius, 0.25);
+  EXPECT_DOUBLE_EQ(strips[0].y, 0.0);
+  EXPECT_DOUBLE_EQ(strips[0].x_min, -1.05);
+  EXPECT_DOUBLE_EQ(strips[0].x_max, -0.55);
+
+  const auto model = character("human3d");
+  std::vector<std::vector<double>> frames{std::vector<double>(model->get()->qpos0, model->get()->qpos0 + model->get()->nq)};
+  std::vector<FilmRow> rows{FilmRow{model->get(), "M0", frames}};
+  FilmStripOptions options;
+  options.tile_width = options.tile_height = 200;
+  options.camera_direction = plan_view(std::vector<PosedModel>{{model->get(), frames}}).direction;
+  options.ground_strips = strips;
+  const Image disc = render_film_strip(rows, options);
+  write_png((out_dir() / "disc.png").string(), disc);
+  GroundStrip across = strips[0];
+  across.radius = 0;
+  options.ground_strips = {across};
+  const Image strip = render_film_strip(rows, options);
+  write_png((out_dir() / "strip.png").string(), strip);
+
+  const GreenArea d = green_area(disc), s = green_area(strip);
+  ASSERT_GT(d.count, 100) << "the disc is in the picture";
+  // Seen from above at an angle, the disc is an ellipse wider than tall, and it covers a
+  // fraction of what the 2.2 m wide strip with the same extent along x covers.
+  EXPECT_GT(d.x1 - d.x0, d.y1 - d.y0);
+  EXPECT_LT(d.count, s.count / 2);
 }
 
 TEST(FilmColumns, OneStrideOfACyclicMotion) {

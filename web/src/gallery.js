@@ -279,9 +279,9 @@ const followBounds = relativeExtent(tiles.map((t) => t.main));
 followBounds.min.z = Math.min(followBounds.min.z, floorZ);
 for (const box of [bounds, viewBounds]) {
   box.min.z = Math.min(box.min.z, floorZ);
-  for (const [x0, x1] of data.scene?.strips || []) {
-    box.expandByPoint(new THREE.Vector3(x0, 0, floorZ));
-    box.expandByPoint(new THREE.Vector3(x1, 0, floorZ));
+  for (const [x0, x1, y = 0, radius = 0] of data.scene?.strips || []) {
+    box.expandByPoint(new THREE.Vector3(x0, y - radius, floorZ));
+    box.expandByPoint(new THREE.Vector3(x1, y + radius, floorZ));
   }
 }
 const center = bounds.getCenter(new THREE.Vector3());
@@ -311,9 +311,11 @@ const center = bounds.getCenter(new THREE.Vector3());
     scene.add(tile);
   }
   const green = layer(0x5fb35f, 0);
-  for (const [x0, x1] of data.scene?.strips || []) {
-    const strip = new THREE.Mesh(new THREE.PlaneGeometry(x1 - x0, 2.2), green);
-    strip.position.set(0.5 * (x0 + x1), 0, floorZ);
+  // A strip across the track, or a disc (a 3D task's landing point and radius).
+  for (const [x0, x1, y = 0, radius = 0] of data.scene?.strips || []) {
+    const shape = radius > 0 ? new THREE.CircleGeometry(radius, 64) : new THREE.PlaneGeometry(x1 - x0, 2.2);
+    const strip = new THREE.Mesh(shape, green);
+    strip.position.set(0.5 * (x0 + x1), y, floorZ);
     strip.receiveShadow = true;
     scene.add(strip);
   }
