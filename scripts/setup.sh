@@ -11,6 +11,7 @@ packages=(
   jq  # scripts/reproduce-table1.sh and scripts/kill-resume.sh read the runs' summary.json
   clang libclang-rt-14-dev  # the libFuzzer targets (fuzz/) and their test (docs/reliability.md)
   chromium
+  libopenmpi-dev openmpi-bin  # mpirun -n R diverse run (src/distribute/, docs/scaling.md)
 )
 # The gallery page (web/) is built with node and npm and tested in Chromium; a node that is
 # already installed (with its own npm) is used as it is.

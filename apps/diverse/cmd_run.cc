@@ -3,6 +3,7 @@
 //   diverse run backflip --n 4 --generations 500 --out runs/backflip
 //   diverse run backflip --vary shape --metric shape --out runs/backflip-shapes
 //   diverse resume runs/backflip
+//   mpirun -n 8 --hostfile hosts diverse run backflip --out runs/backflip   (docs/scaling.md)
 //
 // See src/run/run.h for what a run directory holds.
 #include <CLI/CLI.hpp>
@@ -11,8 +12,8 @@
 
 #include "command.h"
 #include "options.h"
-#include "options.h"
 #include "core/error.h"
+#include "distribute/cluster.h"
 #include "metric/metric.h"
 #include "optimize/diversity.h"
 #include "run/run.h"
@@ -145,6 +146,10 @@ void install_run(CLI::App& app) {
     if (const auto dot = task_name.rfind(".toml"); dot != std::string::npos)
       task_name = task_name.substr(0, dot);
     request.out = a.out.empty() ? "runs/" + task_name : a.out;
+    // Under mpirun with several ranks, rank 0 runs and the others evaluate its samples.
+    const auto cluster = Cluster::join();
+    if (cluster && cluster->rank() > 0) return serve_run(*cluster, a.threads);
+    request.cluster = cluster.get();
     start_run(request);
   });
 }
@@ -167,7 +172,9 @@ void install_resume(CLI::App& app) {
       ->capture_default_str()
       ->check(number_in(0, kMaxCheckpointSeconds));
   cmd->callback([dir, threads, quiet, checkpoint_seconds, no_render] {
-    resume_run(*dir, *threads, *quiet, *checkpoint_seconds, !*no_render);
+    const auto cluster = Cluster::join();
+    if (cluster && cluster->rank() > 0) return serve_run(*cluster, *threads);
+    resume_run(*dir, *threads, *quiet, *checkpoint_seconds, !*no_render, cluster.get());
   });
 }
 

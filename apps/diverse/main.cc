@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 #include <utility>
@@ -46,6 +47,12 @@ std::string one_line(const char* message) {
   return out;
 }
 
+// Under mpirun every rank parses the same command line: only rank 0 reports its errors.
+bool reports_errors() {
+  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+  return rank == nullptr || std::string(rank) == "0";
+}
+
 }  // namespace diverse::cli
 
 int main(int argc, char** argv) {
@@ -84,10 +91,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
+    if (diverse::cli::reports_errors())
+      std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
     return 2;
   } catch (const diverse::UserError& e) {
-    std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
+    if (diverse::cli::reports_errors())
+      std::fprintf(stderr, "diverse: error: %s\n", diverse::cli::one_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "diverse: internal error: %s\n", diverse::cli::one_line(e.what()).c_str());

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -133,6 +135,116 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
 Evaluation MotionProblem::simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
                                    std::shared_ptr<const SharedModel>* model_out) const {
   return evaluator_->evaluate_named(named(x), options, model_out);
+}
+
+namespace {
+
+// Little helpers for encode()/decode(): plain bytes of trivially copyable values.
+class Writer {
+ public:
+  template <class T>
+  void put(const T& value) {
+    const auto* p = reinterpret_cast<const char*>(&value);
+    out_.append(p, sizeof(T));
+  }
+  void put_doubles(const double* data, Eigen::Index count) {
+    put(static_cast<std::uint64_t>(count));
+    out_.append(reinterpret_cast<const char*>(data), static_cast<std::size_t>(count) * sizeof(double));
+  }
+  std::string take() { return std::move(out_); }
+
+ private:
+  std::string out_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::string& in) : in_(in) {}
+  template <class T>
+  T get() {
+    T value;
+    need(sizeof(T));
+    std::memcpy(&value, in_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return value;
+  }
+  // A count of doubles; `rows` divides it when given (matrices of `rows` rows).
+  Eigen::Index count(Eigen::Index rows = 1) {
+    const auto n = get<std::uint64_t>();
+    if (n > (in_.size() - at_) / sizeof(double) || n % static_cast<std::uint64_t>(rows) != 0)
+      throw std::invalid_argument("outcome bytes: bad array length");
+    return static_cast<Eigen::Index>(n);
+  }
+  void doubles(double* data, Eigen::Index n) {
+    need(static_cast<std::size_t>(n) * sizeof(double));
+    std::memcpy(data, in_.data() + at_, static_cast<std::size_t>(n) * sizeof(double));
+    at_ += static_cast<std::size_t>(n) * sizeof(double);
+  }
+  Eigen::VectorXd vector() {
+    Eigen::VectorXd v(count());
+    doubles(v.data(), v.size());
+    return v;
+  }
+  bool done() const { return at_ == in_.size(); }
+
+ private:
+  void need(std::size_t bytes) const {
+    if (in_.size() - at_ < bytes) throw std::invalid_argument("outcome bytes: truncated");
+  }
+  const std::string& in_;
+  std::size_t at_ = 0;
+};
+
+constexpr std::uint32_t kOutcomeMagic = 0x4d4f5431;  // "MOT1"
+
+}  // namespace
+
+std::string MotionProblem::encode(const Outcome& outcome) {
+  const auto& m = dynamic_cast<const MotionOutcome&>(outcome);
+  Writer w;
+  w.put(kOutcomeMagic);
+  w.put(m.constraint);
+  w.put(static_cast<std::uint8_t>(m.failed));
+  w.put(static_cast<std::uint8_t>(m.fell));
+  w.put(m.landing_x);
+  w.put(m.peak_com_z);
+  w.put_doubles(m.scales.data(), m.scales.size());
+  w.put_doubles(m.features.link_lengths.data(), m.features.link_lengths.size());
+  w.put(static_cast<std::uint64_t>(m.features.poses.size()));
+  for (const Pose& pose : m.features.poses) {
+    w.put_doubles(pose.link_com.data(), pose.link_com.size());
+    w.put_doubles(pose.link_mass.data(), pose.link_mass.size());
+    w.put_doubles(pose.angles.data(), pose.angles.size());
+    w.put_doubles(pose.root.coeffs().data(), 4);
+  }
+  return w.take();
+}
+
+std::shared_ptr<const Outcome> MotionProblem::decode(const std::string& bytes) {
+  Reader r(bytes);
+  if (r.get<std::uint32_t>() != kOutcomeMagic) throw std::invalid_argument("outcome bytes: not an outcome");
+  auto m = std::make_shared<MotionOutcome>();
+  m->constraint = r.get<double>();
+  m->failed = r.get<std::uint8_t>() != 0;
+  m->fell = r.get<std::uint8_t>() != 0;
+  m->landing_x = r.get<double>();
+  m->peak_com_z = r.get<double>();
+  m->scales = r.vector();
+  m->features.link_lengths = r.vector();
+  const auto poses = r.get<std::uint64_t>();
+  if (poses > bytes.size()) throw std::invalid_argument("outcome bytes: bad pose count");
+  m->features.poses.resize(static_cast<std::size_t>(poses));
+  for (Pose& pose : m->features.poses) {
+    const Eigen::Index com = r.count(3);
+    pose.link_com.resize(3, com / 3);
+    r.doubles(pose.link_com.data(), com);
+    pose.link_mass = r.vector();
+    pose.angles = r.vector();
+    if (r.count() != 4) throw std::invalid_argument("outcome bytes: bad root quaternion");
+    r.doubles(pose.root.coeffs().data(), 4);
+  }
+  if (!r.done()) throw std::invalid_argument("outcome bytes: trailing bytes");
+  return m;
 }
 
 double MotionProblem::distance(const Outcome& a, const Outcome& b) const {

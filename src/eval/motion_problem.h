@@ -25,6 +25,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "metric/metric.h"
@@ -75,6 +76,12 @@ class MotionProblem : public DiversityProblem {
   // `model_out` receives the model it ran on (the shaped scene's with vary_shape).
   Evaluation simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
                       std::shared_ptr<const SharedModel>* model_out = nullptr) const;
+
+  // A MotionOutcome as bytes and back, bit for bit (doubles travel as their bytes), for
+  // outcomes computed in another process of the same build (distribute/cluster.h).
+  // decode() throws std::invalid_argument on bytes that encode() did not write.
+  static std::string encode(const Outcome& outcome);
+  static std::shared_ptr<const Outcome> decode(const std::string& bytes);
 
   Metric metric() const { return distance_.metric; }
   const DistanceSpec& distance_spec() const { return distance_; }

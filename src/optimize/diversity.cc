@@ -69,9 +69,9 @@ std::shared_ptr<const Outcome> checked(std::shared_ptr<const Outcome> outcome) {
 }
 
 // Evaluates several points on the pool, one outcome per point, in index order.
-std::vector<std::shared_ptr<const Outcome>> evaluate_all(const DiversityProblem& problem,
-                                                         ThreadPool& pool,
-                                                         const std::vector<Eigen::VectorXd>& xs) {
+std::vector<std::shared_ptr<const Outcome>> evaluate_on_pool(const DiversityProblem& problem,
+                                                             ThreadPool& pool,
+                                                             const std::vector<Eigen::VectorXd>& xs) {
   std::vector<std::shared_ptr<const Outcome>> outcomes(xs.size());
   pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
     outcomes[k] = checked(problem.evaluate(xs[k], worker));
@@ -224,12 +224,24 @@ DiversityRecord record_from_json(const nlohmann::json& j) {
 
 }  // namespace
 
-DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool)
-    : problem_(&problem), pool_(&pool) {}
+DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool,
+                                       BatchEvaluator* batch)
+    : problem_(&problem), pool_(&pool), batch_(batch) {}
+
+std::vector<std::shared_ptr<const Outcome>> DiversityOptimizer::evaluate_all(
+    const std::vector<Eigen::VectorXd>& xs) const {
+  if (!batch_) return evaluate_on_pool(*problem_, *pool_, xs);
+  std::vector<std::shared_ptr<const Outcome>> outcomes = batch_->evaluate(xs);
+  if (outcomes.size() != xs.size())
+    throw std::logic_error("diversity: BatchEvaluator returned the wrong number of outcomes");
+  for (auto& outcome : outcomes) outcome = checked(std::move(outcome));
+  return outcomes;
+}
 
 DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
-                                       const DiversityOptions& options, ThreadPool& pool)
-    : problem_(&problem), pool_(&pool), options_(options) {
+                                       const DiversityOptions& options, ThreadPool& pool,
+                                       BatchEvaluator* batch)
+    : problem_(&problem), pool_(&pool), batch_(batch), options_(options) {
   validate(options_);
   const int n = options_.variations;
   const int dim = problem_->dim();
@@ -240,7 +252,7 @@ DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
   }
 
   // Every variation starts at P_0, so all share M_0's outcome until they move.
-  const auto m0 = evaluate_all(*problem_, *pool_, {p0}).front();
+  const auto m0 = evaluate_all({p0}).front();
   evaluations_ = 1;
   points_.assign(n + 1, p0);
   outcomes_.assign(n + 1, m0);
@@ -385,7 +397,7 @@ void DiversityOptimizer::step_variation(int v) {
   // single evaluation does not leave the other workers idle.
   std::vector<Eigen::VectorXd> batch = xs;
   if (pending_ > 0) batch.push_back(points_[pending_]);  // only with VariationPoint::kMean
-  const auto outcomes = evaluate_all(*problem_, *pool_, batch);
+  const auto outcomes = evaluate_all(batch);
   if (pending_ > 0) settle_pending(outcomes.back());
   evaluations_ += static_cast<long long>(xs.size());
 
@@ -431,12 +443,11 @@ void DiversityOptimizer::step_joint() {
   const std::size_t lambda = xs.size();
 
   // Every sample is a whole set M_1..M_N: N evaluations each, all independent.
-  std::vector<std::shared_ptr<const Outcome>> outcomes(lambda * n);
-  pool_->parallel_for(lambda * n, [&](std::size_t index, int worker) {
-    const std::size_t k = index / n;
-    const int v = static_cast<int>(index % n);
-    outcomes[index] = checked(problem_->evaluate(xs[k].segment(v * dim, dim), worker));
-  });
+  std::vector<Eigen::VectorXd> motions;
+  motions.reserve(lambda * n);
+  for (std::size_t k = 0; k < lambda; ++k)
+    for (int v = 0; v < n; ++v) motions.push_back(xs[k].segment(v * dim, dim));
+  const std::vector<std::shared_ptr<const Outcome>> outcomes = evaluate_all(motions);
   evaluations_ += static_cast<long long>(lambda * n);
   std::vector<double> D(lambda), C(lambda);
   pool_->parallel_for(lambda, [&](std::size_t k, int) {
@@ -464,7 +475,7 @@ void DiversityOptimizer::step_joint() {
   const Eigen::VectorXd mean = es.mean();
   std::vector<Eigen::VectorXd> means;
   for (int v = 1; v <= n; ++v) means.push_back(mean.segment((v - 1) * dim, dim));
-  const auto mean_outcomes = evaluate_all(*problem_, *pool_, means);
+  const auto mean_outcomes = evaluate_all(means);
   evaluations_ += n;
   for (int v = 1; v <= n; ++v) {
     points_[v] = means[v - 1];
@@ -504,7 +515,7 @@ void DiversityOptimizer::finish_step(int variation) {
 }
 
 void DiversityOptimizer::end_generation() {
-  if (pending_ > 0) settle_pending(evaluate_all(*problem_, *pool_, {points_[pending_]}).front());
+  if (pending_ > 0) settle_pending(evaluate_all({points_[pending_]}).front());
   best_history_.push_back(merit(best_.score));
   const int window = options_.window;
   // Stagnation: over the window, the best set neither lost violation nor gained epsilon D.
@@ -613,14 +624,14 @@ nlohmann::json DiversityOptimizer::checkpoint() const {
 
 DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& problem,
                                                        const nlohmann::json& j,
-                                                       ThreadPool& pool) {
+                                                       ThreadPool& pool, BatchEvaluator* batch) {
   if (!j.is_object() || j.value("format", std::string()) != kCheckpointFormat) {
     throw UserError(std::string("checkpoint: format: expected \"") + kCheckpointFormat + "\"");
   }
   if (j.value("version", 0) != kCheckpointVersion) {
     throw UserError("checkpoint: version: expected " + std::to_string(kCheckpointVersion));
   }
-  DiversityOptimizer opt(problem, pool);
+  DiversityOptimizer opt(problem, pool, batch);
   try {
     opt.options_ = diversity_options_from_json(j.at("options"));
     validate(opt.options_);
@@ -706,7 +717,7 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
   std::vector<std::size_t> current_index, best_index;
   for (const auto& p : opt.points_) current_index.push_back(index_of(p));
   for (const auto& p : opt.best_.points) best_index.push_back(index_of(p));
-  const auto outcomes = evaluate_all(problem, pool, distinct);
+  const auto outcomes = opt.evaluate_all(distinct);
   for (std::size_t i : current_index) opt.outcomes_.push_back(outcomes[i]);
   for (std::size_t i : best_index) opt.best_.outcomes.push_back(outcomes[i]);
 

@@ -86,6 +86,7 @@
 #include <vector>
 
 #include "core/thread_pool.h"
+#include "optimize/batch_evaluator.h"
 #include "optimize/cmaes.h"
 #include "optimize/objective.h"
 
@@ -171,14 +172,17 @@ class DiversityOptimizer {
   using Callback = std::function<void(const DiversityRecord&)>;
 
   // Evaluates P_0 once. The problem and pool must outlive the optimizer; the pool's size
-  // is the number of workers the problem was prepared for.
+  // is the number of workers the problem was prepared for. With `batch` (which must
+  // outlive the optimizer too), every evaluation goes through it instead of the pool
+  // (optimize/batch_evaluator.h); the pool still scores the samples.
   DiversityOptimizer(const DiversityProblem& problem, const DiversityOptions& options,
-                     ThreadPool& pool);
+                     ThreadPool& pool, BatchEvaluator* batch = nullptr);
   // Restores from checkpoint(). Throws UserError if the checkpoint does not fit the
   // problem (dimension or reference differ) and std::logic_error if re-evaluating the
   // stored sets does not reproduce their recorded D (evaluate() is not deterministic).
   static DiversityOptimizer from_checkpoint(const DiversityProblem& problem,
-                                            const nlohmann::json& checkpoint, ThreadPool& pool);
+                                            const nlohmann::json& checkpoint, ThreadPool& pool,
+                                            BatchEvaluator* batch = nullptr);
 
   // Called after every step with its log record (also kept in log()).
   void set_callback(Callback callback) { callback_ = std::move(callback); }
@@ -232,7 +236,9 @@ class DiversityOptimizer {
     DiversityScore score;
   };
 
-  DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool);
+  DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool, BatchEvaluator* batch);
+  // Outcomes of xs in index order: through batch_ if set, else on the pool.
+  std::vector<std::shared_ptr<const Outcome>> evaluate_all(const std::vector<Eigen::VectorXd>& xs) const;
   CmaesOptions cma_options(int dim, int instance) const;
   int present() const;  // motions in the current set, M_0 included
   void step_variation(int variation);
@@ -245,6 +251,7 @@ class DiversityOptimizer {
 
   const DiversityProblem* problem_;
   ThreadPool* pool_;
+  BatchEvaluator* batch_ = nullptr;
   DiversityOptions options_;
   Callback callback_;
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "distribute/cluster.h"
 #include "io/files.h"
 
 namespace diverse {
@@ -47,10 +48,13 @@ nlohmann::json read_run_checkpoint(const fs::path& file, bool vary_shape, double
 
 std::unique_ptr<DiversityOptimizer> restore_optimizer(const DiversityProblem& problem,
                                                       const nlohmann::json& state, ThreadPool& pool,
-                                                      const fs::path& file) {
+                                                      const fs::path& file, BatchEvaluator* batch) {
   const std::string where = file.string();
   try {
-    return std::make_unique<DiversityOptimizer>(DiversityOptimizer::from_checkpoint(problem, state, pool));
+    return std::make_unique<DiversityOptimizer>(
+        DiversityOptimizer::from_checkpoint(problem, state, pool, batch));
+  } catch (const ClusterError&) {
+    throw;  // a rank of the run failed, not the file
   } catch (const UserError& e) {
     throw UserError(where + ": " + e.what());
   } catch (const nlohmann::json::exception& e) {

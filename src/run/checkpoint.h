@@ -37,8 +37,10 @@ nlohmann::json read_run_checkpoint(const std::filesystem::path& file, bool vary_
 // The optimizer restored from read_run_checkpoint()'s state. Every failure is a UserError
 // naming `file`: a state that does not fit the problem or is malformed, and one whose
 // re-evaluated sets do not reproduce their recorded D.
+// `batch` as for DiversityOptimizer (nullptr: the pool evaluates).
 std::unique_ptr<DiversityOptimizer> restore_optimizer(const DiversityProblem& problem,
                                                       const nlohmann::json& state, ThreadPool& pool,
-                                                      const std::filesystem::path& file);
+                                                      const std::filesystem::path& file,
+                                                      BatchEvaluator* batch = nullptr);
 
 }  // namespace diverse

@@ -159,9 +159,11 @@ void write_run_outputs(const RunOutputs& o) {
       {"timing",
        {{"wall_seconds", o.wall_seconds},
         {"threads", o.pool.size()},
+        {"ranks", o.ranks},
         {"evaluations_per_second",
          o.wall_seconds > 0 ? static_cast<double>(result.evaluations) / o.wall_seconds : 0.0}}}};
   if (objective.combined()) summary["shape_weight"] = objective.shape_weight;
+  if (!o.messages.is_null()) summary["timing"]["messages"] = o.messages;
   write_json_atomic(o.dir / "summary.json", summary);
 
   // The film strip is drawn from the files just written, as `diverse render` draws it.

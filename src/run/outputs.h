@@ -23,6 +23,8 @@ struct RunOutputs {
   ThreadPool& pool;
   double wall_seconds = 0;  // total, over all sessions of the run
   bool render = true;
+  int ranks = 1;            // processes that evaluated (mpirun -n; distribute/cluster.h)
+  nlohmann::json messages = nullptr;  // ranks > 1: what went between them ("timing" "messages")
 };
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"

@@ -1,5 +1,6 @@
 #include "run/run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -7,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/thread_pool.h"
+#include "distribute/cluster.h"
 #include "eval/motion_problem.h"
 #include "io/files.h"
 #include "io/progress.h"
@@ -83,16 +85,65 @@ bool read_vary_shape(const nlohmann::json& run, const std::string& where) {
   throw_field_error(where, "vary", "expected [\"control\"] or [\"control\", \"shape\"]");
 }
 
-int resolve_threads(int threads) {
+int resolve_threads(int threads, const Cluster* cluster) {
   if (threads < 0) throw UserError("--threads: expected an integer >= 0 (0 = one per core)");
-  return threads == 0 ? ThreadPool::hardware_threads() : threads;
+  if (threads > 0) return threads;
+  return cluster ? cluster->default_threads() : ThreadPool::hardware_threads();
+}
+
+// What a worker rank needs to build the same problem as rank 0 (serve_run reads it).
+std::string cluster_setup(const RunSetup& setup) {
+  const Eigen::VectorXd m0 = setup.m0.normalized();
+  nlohmann::json j = {{"diverse_version", DIVERSE_VERSION},
+                      {"task_file", setup.task_path},
+                      {"task_text", setup.task_text},
+                      {"metric", to_string(setup.distance)},
+                      {"shape_weight", setup.distance.shape_weight},
+                      {"vary_shape", setup.vary_shape},
+                      {"reference", std::vector<double>(m0.data(), m0.data() + m0.size())}};
+  return j.dump();
+}
+
+// The line rank 0 prints when mpirun stops it (a worker died, or the job was interrupted).
+std::string stopped_line(const fs::path& dir, long long generation) {
+  return "diverse: error: the run was stopped by mpirun (a rank ended, e.g. killed or its "
+         "node lost, or the job was interrupted; mpirun names which); `diverse resume " +
+         dir.string() + "` continues from " +
+         (generation >= 0 ? "the last checkpoint (generation " + std::to_string(generation) + ")"
+                          : std::string("the start (run.json holds the settings)"));
+}
+
+// summary.json's timing.messages: this session's traffic between the ranks.
+nlohmann::json messages_json(const Cluster::Traffic& t) {
+  const double n = t.tasks > 0 ? static_cast<double>(t.tasks) : 1.0;
+  std::vector<double> ms = t.compute_ms;
+  std::sort(ms.begin(), ms.end());
+  auto quantile = [&](double q) {
+    return ms.empty() ? 0.0 : ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1) + 0.5)];
+  };
+  return {{"remote_evaluations", t.tasks},
+          {"task_bytes_per_evaluation", static_cast<double>(t.task_bytes) / n},
+          {"result_bytes_per_evaluation", static_cast<double>(t.result_bytes) / n},
+          {"round_trip_ms_per_evaluation", 1e3 * t.round_trip_seconds / n},
+          {"remote_rollout_ms", {{"mean", 1e3 * t.compute_seconds / n},
+                                 {"p10", quantile(0.1)}, {"p50", quantile(0.5)},
+                                 {"p90", quantile(0.9)}, {"max", quantile(1.0)}}},
+          {"overhead_us_per_evaluation", 1e6 * (t.round_trip_seconds - t.compute_seconds) / n}};
+}
+
+// Rank 0 of several: workers get the settings; batches go over every rank.
+std::unique_ptr<BatchEvaluator> cluster_evaluator(Cluster* cluster, const RunSetup& setup,
+                                                  const MotionProblem& problem, ThreadPool& pool) {
+  if (!cluster) return nullptr;
+  cluster->start_workers(cluster_setup(setup));
+  return cluster->evaluator(problem, pool, &MotionProblem::decode);
 }
 
 // The optimization loop shared by start and resume: steps, checkpoints, progress, and
 // the outputs at the end.
 void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& problem,
            DiversityOptimizer& optimizer, ThreadPool& pool, double wall_before,
-           double checkpoint_seconds, bool quiet, bool render) {
+           double checkpoint_seconds, bool quiet, bool render, Cluster* cluster) {
   const auto started = std::chrono::steady_clock::now();
   auto elapsed = [&] {
     return wall_before +
@@ -115,6 +166,7 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
                            : std::string("no checkpoint was written")));
     }
     saved_generation = optimizer.generation();
+    if (cluster) cluster->set_stop_message(stopped_line(dir, saved_generation));
   };
 
   std::FILE* sink = quiet ? nullptr : stderr;
@@ -145,6 +197,8 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   RunOutputs outputs{dir, *setup.evaluator, problem, optimizer, pool};
   outputs.wall_seconds = elapsed();
   outputs.render = render;
+  outputs.ranks = cluster ? cluster->size() : 1;
+  if (cluster) outputs.messages = messages_json(cluster->traffic());
   write_run_outputs(outputs);
   if (sink) std::fprintf(sink, "results in %s (summary.json, motions/, filmstrip.png)\n",
                          dir.string().c_str());
@@ -163,7 +217,7 @@ nlohmann::json without_timing(nlohmann::json summary) {
 }
 
 void start_run(const RunRequest& request) {
-  const int threads = resolve_threads(request.threads);
+  const int threads = resolve_threads(request.threads, request.cluster);
   RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.shape_weight,
                               request.vary_shape, request.options);
   try {
@@ -184,17 +238,20 @@ void start_run(const RunRequest& request) {
   ensure_writable_directory(request.out);
   write_json_atomic(request.out / "run.json", run_json(setup));
 
+  if (request.cluster) request.cluster->set_stop_message(stopped_line(request.out, -1));
+
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape);
-  DiversityOptimizer optimizer(problem, setup.options, pool);
+  const auto batch = cluster_evaluator(request.cluster, setup, problem, pool);
+  DiversityOptimizer optimizer(problem, setup.options, pool, batch.get());
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
-        request.quiet, request.render);
+        request.quiet, request.render, request.cluster);
 }
 
 void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpoint_seconds,
-                bool render) {
-  const int threads = resolve_threads(threads_arg);
+                bool render, Cluster* cluster) {
+  const int threads = resolve_threads(threads_arg, cluster);
   if (!fs::is_directory(dir)) throw UserError(dir.string() + ": not a directory");
   if (!fs::exists(dir / "run.json"))
     throw UserError(dir.string() + ": not a run directory (no run.json; start one with `diverse run`)");
@@ -237,13 +294,55 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   std::unique_ptr<DiversityOptimizer> optimizer;
   if (fs::exists(dir / "checkpoint.json")) {
     const nlohmann::json state = read_run_checkpoint(dir / "checkpoint.json", setup.vary_shape, &wall_before);
-    optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json");
+    if (cluster)
+      cluster->set_stop_message(stopped_line(dir, state.value("generation", -1LL)));
+    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
+    optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
+    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
   } else {
     // Stopped between writing run.json and its first checkpoint: run.json holds every
     // setting, so the run starts again from generation 0 (the same run, by determinism).
-    optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool);
+    if (cluster) cluster->set_stop_message(stopped_line(dir, -1));
+    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
+    optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
   }
-  drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render);
+}
+
+void serve_run(Cluster& cluster, int threads_arg) {
+  std::string text;
+  if (!cluster.receive_setup(&text)) return;  // rank 0 ended before the run began
+  std::unique_ptr<MotionProblem> problem;
+  RunSetup setup;
+  int threads = 1;
+  try {
+    threads = resolve_threads(threads_arg, &cluster);
+    const nlohmann::json j = nlohmann::json::parse(text);
+    const std::string version = j.at("diverse_version").get<std::string>();
+    if (version != DIVERSE_VERSION)
+      throw UserError("runs diverse " + std::string(DIVERSE_VERSION) + ", rank 0 runs " + version +
+                      "; every rank must run the same build");
+    const std::string task_file = j.at("task_file").get<std::string>();
+    if (!fs::exists(task_file))
+      throw UserError(task_file + ": does not exist on this node (every node needs the task's "
+                      "files at the same path as rank 0)");
+    if (read_file(task_file) != j.at("task_text").get<std::string>())
+      throw UserError(task_file + ": differs from rank 0's copy; every node needs the same task files");
+    setup = make_setup(task_file, j.at("metric").get<std::string>(), j.at("shape_weight").get<double>(),
+                       j.at("vary_shape").get<bool>(), DiversityOptions{});
+    const std::vector<double> reference = j.at("reference").get<std::vector<double>>();
+    const Eigen::VectorXd m0 = setup.m0.normalized();
+    if (static_cast<Eigen::Index>(reference.size()) != m0.size() ||
+        !std::equal(reference.begin(), reference.end(), m0.data()))
+      throw UserError(setup.evaluator->task().m0 +
+                      ": differs from rank 0's input motion; every node needs the same files");
+    problem = std::make_unique<MotionProblem>(*setup.evaluator, setup.distance, m0, threads,
+                                              setup.vary_shape);
+  } catch (const std::exception& e) {
+    cluster.refuse_setup(e.what());
+    return;
+  }
+  cluster.serve(*problem, threads, &MotionProblem::encode);
 }
 
 }  // namespace diverse

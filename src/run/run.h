@@ -19,7 +19,10 @@
 //                       MJCF text)
 //   filmstrip.png       M0..MN at the same phase events, one row each
 //
-// Results never depend on the thread count or on interruptions: a run killed at any
+// Under `mpirun -n R` rank 0 does all of the above and the other ranks only evaluate
+// samples (distribute/cluster.h); the files are the same as a single process writes.
+//
+// Results never depend on the thread count, the number of ranks or on interruptions: a run killed at any
 // moment and resumed from its checkpoint ends with the same summary.json as an
 // uninterrupted one, except for the "timing" object (wall time, threads).
 #pragma once
@@ -31,6 +34,8 @@
 #include "optimize/diversity.h"
 
 namespace diverse {
+
+class Cluster;  // distribute/cluster.h
 
 struct RunRequest {
   std::string task;                 // task name or path (resolve_task_path)
@@ -45,6 +50,9 @@ struct RunRequest {
   double checkpoint_seconds = 5.0;  // wall time between checkpoints
   bool render = true;               // write filmstrip.png at the end
   bool quiet = false;               // no progress output
+  Cluster* cluster = nullptr;       // rank 0 of several (mpirun): rollouts spread over
+                                    // every rank; threads = 0 then means this node's
+                                    // cores shared among its ranks
 };
 
 // Starts a run. Throws UserError on bad input or if `out` holds a run and !force.
@@ -55,7 +63,13 @@ void start_run(const RunRequest& request);
 // checkpoint starts again from run.json's settings. Throws UserError if `dir` is not
 // a run directory, its checkpoint is corrupt, or its task file changed.
 void resume_run(const std::filesystem::path& dir, int threads, bool quiet = false,
-                double checkpoint_seconds = 5.0, bool render = true);
+                double checkpoint_seconds = 5.0, bool render = true, Cluster* cluster = nullptr);
+
+// A rank other than 0 of `mpirun -n R diverse run|resume`: waits for rank 0's settings,
+// builds the same problem from its own copy of the task's files (refusing, through rank
+// 0, files that differ from rank 0's), evaluates rank 0's samples with `threads` threads
+// (0 = this node's cores shared among its ranks) and returns when rank 0 ends.
+void serve_run(Cluster& cluster, int threads);
 
 // Removes the "timing" object: what must be identical between equivalent runs.
 nlohmann::json without_timing(nlohmann::json summary);

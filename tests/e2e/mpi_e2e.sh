@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# `mpirun -n 2 diverse run|resume` (src/distribute/cluster.h) against one process, on
+# jump_high with N = 2, 8 samples per generation, one thread per rank:
+#
+#   mpi_e2e.sh DIVERSE_BINARY SOURCE_DIR MPIRUN
+#
+# 1. Two ranks give the summary.json of one process (the "timing" object aside), and
+#    "timing" says 2 ranks.
+# 2. A run of 2 ranks killed (rank 0, SIGKILL) after its checkpoint of generation 2 and
+#    resumed by one process, and a run of one process killed the same way and resumed by 2
+#    ranks, both end with the uninterrupted run's summary.
+# 3. A worker rank killed (SIGKILL) mid-run: rank 0 prints one line naming what happened
+#    and `diverse resume DIR`, exits 2 (mpirun reports the killed rank's status), and the
+#    checkpoint left behind resumes, under 2 ranks, to the uninterrupted run's summary.
+# E2E_KEEP=DIR keeps the outputs in DIR.
+set -uo pipefail
+command -v jq >/dev/null || { echo "FAILED: needs jq (scripts/setup.sh installs it)"; exit 1; }
+diverse="$1"
+src="$2"
+mpirun="$3"
+task="$src/tasks/jump_high.toml"
+
+if [ -n "${E2E_KEEP:-}" ]; then
+  work="$E2E_KEEP"
+  rm -rf "$work"
+  mkdir -p "$work"
+else
+  work="$(mktemp -d)"
+  trap 'rm -rf "$work"' EXIT
+fi
+# Root may start ranks only when it says so; two ranks on this machine whatever its cores.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+mpi=("$mpirun" -n 2 --oversubscribe)
+
+fail() {
+  echo "FAILED: $*"
+  exit 1
+}
+summary() { jq -S 'del(.timing)' "$1/summary.json"; }
+generation() { jq -e '.optimizer.generation' "$1/checkpoint.json" 2>/dev/null || echo -1; }
+# The pid of rank R among the processes mpirun (pid $1) started.
+rank_pid() {
+  for p in $(pgrep -P "$1"); do
+    if tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$2"; then
+      echo "$p"
+      return 0
+    fi
+  done
+  return 1
+}
+# Waits until DIR's checkpoint has reached generation G (or PID has ended).
+wait_generation() {
+  local dir="$1" g="$2" pid="$3"
+  for _ in $(seq 1 3000); do
+    [ "$(generation "$dir")" -ge "$g" ] && return 0
+    kill -0 "$pid" 2>/dev/null || return 1
+    sleep 0.01
+  done
+  return 1
+}
+
+args=(--n 2 --popsize 8 --sigma0 0.03 --seed 3 --threads 1 --quiet --no-render)
+
+# 1. Same summary from one process and from two ranks (3 generations).
+"$diverse" run "$task" "${args[@]}" --generations 3 --out "$work/one" || fail "diverse run (one process)"
+"${mpi[@]}" "$diverse" run "$task" "${args[@]}" --generations 3 --out "$work/two" >"$work/two.txt" 2>&1 ||
+  { cat "$work/two.txt"; fail "mpirun -n 2 diverse run"; }
+[ "$(summary "$work/one")" == "$(summary "$work/two")" ] ||
+  { diff <(summary "$work/one") <(summary "$work/two") | head -20; fail "2 ranks: summary.json differs from one process's"; }
+[ "$(jq '.timing.ranks' "$work/two/summary.json")" == 2 ] || fail "2 ranks: timing.ranks is not 2"
+[ "$(jq '.timing.ranks' "$work/one/summary.json")" == 1 ] || fail "one process: timing.ranks is not 1"
+echo "ok: 2 ranks = 1 process"
+
+# The uninterrupted run the interrupted ones must end with (6 generations, a checkpoint
+# after every generation).
+long=("${args[@]}" --generations 6 --checkpoint-seconds 0)
+"$diverse" run "$task" "${long[@]}" --out "$work/reference" || fail "diverse run (reference)"
+reference="$(summary "$work/reference")"
+
+# 2a. Two ranks, rank 0 killed, resumed by one process.
+"${mpi[@]}" "$diverse" run "$task" "${long[@]}" --out "$work/a" >"$work/a.txt" 2>&1 &
+mpid=$!
+wait_generation "$work/a" 2 "$mpid" || { cat "$work/a.txt"; fail "2a: the 2-rank run ended before generation 2"; }
+kill -9 "$(rank_pid "$mpid" 0)" || fail "2a: no rank 0 to kill"
+wait "$mpid"
+[ -f "$work/a/summary.json" ] && fail "2a: the run finished before the kill"
+"$diverse" resume "$work/a" --threads 1 --quiet --no-render || fail "2a: diverse resume (one process)"
+[ "$(summary "$work/a")" == "$reference" ] || fail "2a: 2 ranks then 1 process: summary differs"
+echo "ok: 2 ranks, killed, resumed by 1 process = uninterrupted"
+
+# 2b. One process killed, resumed by two ranks.
+"$diverse" run "$task" "${long[@]}" --out "$work/b" &
+pid=$!
+wait_generation "$work/b" 2 "$pid" || fail "2b: the run ended before generation 2"
+kill -9 "$pid"
+wait "$pid"
+[ -f "$work/b/summary.json" ] && fail "2b: the run finished before the kill"
+"${mpi[@]}" "$diverse" resume "$work/b" --threads 1 --quiet --no-render >"$work/b.txt" 2>&1 ||
+  { cat "$work/b.txt"; fail "2b: mpirun -n 2 diverse resume"; }
+[ "$(summary "$work/b")" == "$reference" ] || fail "2b: 1 process then 2 ranks: summary differs"
+echo "ok: 1 process, killed, resumed by 2 ranks = uninterrupted"
+
+# 3. A worker rank killed.
+"${mpi[@]}" "$diverse" run "$task" "${long[@]}" --out "$work/c" >"$work/c.txt" 2>&1 &
+mpid=$!
+wait_generation "$work/c" 2 "$mpid" || { cat "$work/c.txt"; fail "3: the run ended before generation 2"; }
+kill -9 "$(rank_pid "$mpid" 1)" || fail "3: no rank 1 to kill"
+wait "$mpid"
+status=$?
+cat "$work/c.txt"
+[ "$status" -ne 0 ] || fail "3: mpirun exited 0 after a worker was killed"
+[ -f "$work/c/summary.json" ] && fail "3: the run finished before the kill"
+lines="$(grep -c '^diverse: error: ' "$work/c.txt")"
+[ "$lines" == 1 ] || fail "3: expected one 'diverse: error:' line, got $lines"
+grep -q "^diverse: error: the run was stopped by mpirun (a rank ended.*; \`diverse resume $work/c\` continues from the last checkpoint (generation [0-9]*)$" \
+  "$work/c.txt" || fail "3: the error line does not name what happened and how to resume"
+"${mpi[@]}" "$diverse" resume "$work/c" --threads 1 --quiet --no-render >"$work/c2.txt" 2>&1 ||
+  { cat "$work/c2.txt"; fail "3: mpirun -n 2 diverse resume after the killed worker"; }
+[ "$(summary "$work/c")" == "$reference" ] || fail "3: resumed after a killed worker: summary differs"
+echo "ok: killed worker: one line, resumable"
+
+echo "mpi_e2e: all passed"
