@@ -211,6 +211,7 @@ std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body) 
   specs.push_back({"land.duration", 0.05, 0.8, "s"});
   specs.push_back({"crouch.lean", -0.15, 0.15, "m"});
   specs.push_back({"extend.lean", -0.4, 0.4, "m"});
+  specs.push_back({"extend.speed", -6.0, 6.0, "m/s"});
   specs.push_back({"land.balance_offset", -0.1, 0.1, "m"});
   specs.push_back({"landing.offset", -0.4, 0.4, "m"});
   specs.push_back({"landing.velocity_gain", -0.4, 0.4, "s"});
@@ -257,7 +258,7 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
 }
 
 void Jump3dController::set_parameters(const std::vector<double>& values) {
-  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 8;
+  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 9;
   if (values.size() != count) throw std::logic_error("Jump3dController: parameter count");
   size_t k = 0;
   for (int p = 0; p < kNumJumpPhases; ++p) {
@@ -272,6 +273,7 @@ void Jump3dController::set_parameters(const std::vector<double>& values) {
   land_duration_ = values[k++];
   lean_ = values[k++];
   extend_lean_ = values[k++];
+  extend_speed_ = values[k++];
   land_offset_ = values[k++];
   landing_offset_ = values[k++];
   landing_velocity_gain_ = values[k++];
@@ -394,6 +396,10 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
     const double h = stance_->heading();
     const double offset = phase == kLand ? land_offset_ : phase == kExtend ? extend_lean_ : lean_;
     stance_->set_com_offset(offset * std::cos(h), offset * std::sin(h));
+    // The push-off drives the COM towards a speed along the heading; the other stance
+    // phases hold it still.
+    const double speed = phase == kExtend ? extend_speed_ : 0.0;
+    stance_->set_com_velocity(speed * std::cos(h), speed * std::sin(h));
     stance_->set_com_force(phase == kExtend ? StanceController::ComForce::kPush : StanceController::ComForce::kSupport);
     switch (phase) {
       case kStart: phase_duration_ = start_duration_; break;

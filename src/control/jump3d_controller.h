@@ -6,7 +6,8 @@
 //           targets interpolated over start.duration
 //   crouch  stance, the same, over crouch.duration
 //   extend  stance, the targets applied at once with the phase's gains, the COM driven
-//           toward `extend.lean` from the soles' centre (the force not held to the support
+//           toward `extend.lean` from the soles' centre and to the horizontal speed
+//           `extend.speed` along the heading (the force not held to the support
 //           polygon: the feet may tip): the legs push; ends when the
 //           character is airborne (no contact for airborne_time, COM rising), or gives
 //           up after extend_timeout
@@ -113,8 +114,8 @@ class Jump3dController : public Controller {
 
   // The free parameters for `body`: per phase a value per parameterized group and kp, kd
   // of hips, knees and ankles; then the durations, the leans of crouch and extend, the
-  // landing balance offset and the landing controller's offset and velocity gain (80 for
-  // the 3D human, 68 for the bird robot).
+  // push-off speed, the landing balance offset and the landing controller's offset and
+  // velocity gain (81 for the 3D human, 69 for the bird robot).
   static std::vector<ParamSpec> parameter_specs(const Character& body);
   void set_parameters(const std::vector<double>& values);
 
@@ -164,7 +165,7 @@ class Jump3dController : public Controller {
   std::array<std::vector<double>, kNumJumpPhases> pose_{};
   std::array<std::array<double, 3>, kNumJumpPhases> kp_{}, kd_{};
   double start_duration_ = 0.2, crouch_duration_ = 0.4, land_duration_ = 0.3;
-  double lean_ = 0, extend_lean_ = 0, land_offset_ = 0, landing_offset_ = 0, landing_velocity_gain_ = 0;
+  double lean_ = 0, extend_lean_ = 0, extend_speed_ = 0, land_offset_ = 0, landing_offset_ = 0, landing_velocity_gain_ = 0;
 
   // Set at reset() from the model.
   std::unique_ptr<StanceController> stance_;

@@ -478,9 +478,9 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
 
     const double M = mass_;
     double fx =
-        M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * com_vel_[0]);
+        M * (gains_.com_kp * (support_[0] + offset_[0] - com_[0]) - gains_.com_kd * (com_vel_[0] - velocity_[0]));
     double fy =
-        M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * com_vel_[1]);
+        M * (gains_.com_kp * (support_[1] + offset_[1] - com_[1]) - gains_.com_kd * (com_vel_[1] - velocity_[1]));
     const double servo = com_force_ == ComForce::kBalance ? gains_.height_kp * (height_target_ - com_[2]) : 0;
     double fz = M * (gravity_ + servo - gains_.height_kd * com_vel_[2]);
     fz = std::max(fz, 0.1 * M * gravity_);

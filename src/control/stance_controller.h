@@ -14,10 +14,11 @@
 // Per step, with the stance legs those whose foot (or a body below it) touches something:
 //
 // - Centre of mass. A virtual force on the COM (Pratt et al. 2001),
-//       F_xy = M (com_kp (s + offset - c) - com_kd v),
+//       F_xy = M (com_kp (s + offset - c) - com_kd (v - v_d)),
 //       F_z  = M (g + height_kp (h0 - c_z) - height_kd v_z),
-//   with s the centre of the stance soles, c and v the COM and its velocity, h0 the COM
-//   height at reset(). F_xy is limited so that the centre of pressure it implies,
+//   with s the centre of the stance soles, c and v the COM and its velocity, v_d a
+//   horizontal COM velocity to reach (0 to stand; a push-off's speed), h0 the COM height
+//   at reset(). F_xy is limited so that the centre of pressure it implies,
 //   p = c_xy - h F_xy / F_z (h the COM height above the soles), stays cop_margin inside
 //   the support polygon (the convex hull of the stance soles): a larger ankle torque would
 //   only tip the feet.
@@ -96,6 +97,9 @@ class StanceController {
   const std::vector<double>& targets() const { return targets_; }
   // Where the COM is held relative to the centre of the stance soles (m, world x, y).
   void set_com_offset(double x, double y) { offset_ = {x, y}; }
+  // The horizontal COM velocity the virtual force's damping drives towards (m/s, world x,
+  // y): 0 holds the COM still; a push-off sets the speed it leaves the ground with.
+  void set_com_velocity(double x, double y) { velocity_ = {x, y}; }
 
   // Adjustments for a controller that runs stance control as phases of a larger state
   // machine (control/jump3d_controller.h).
@@ -166,6 +170,7 @@ class StanceController {
   StanceGains gains_;
   std::vector<double> targets_;
   std::array<double, 2> offset_{0, 0};
+  std::array<double, 2> velocity_{0, 0};
   ComForce com_force_ = ComForce::kBalance;
   double pitch_root_ = 0, pitch_torso_ = 0, pitch_foot_ = 0;
   std::vector<double> kp_, kd_gain_;  // per joint: PD gains

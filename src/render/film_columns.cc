@@ -100,11 +100,14 @@ FilmColumns motion_film_columns(const PhaseTimes& p, const StepRecorder& record)
   };
   int first = 0, length = 0;
   if (last_stride(p, &first, &length)) {
+    // A column at each state's start, and one in its middle unless the state is short (a
+    // strike state that ends at once would show the same moment three times).
+    const double mean = (p.at(first + length) - p.at(first)) / length;
     for (int k = first; k < first + length; ++k) {
       const double begin = p.at(k), next = p.at(k + 1);
       const std::string& name = p.names[static_cast<std::size_t>(k)];
       add(name, begin);
-      add(std::string("mid ").append(name), 0.5 * (begin + next));
+      if (next - begin >= 0.5 * mean) add(std::string("mid ").append(name), 0.5 * (begin + next));
     }
     add(p.names[static_cast<std::size_t>(first)], p.at(first + length));
     return columns;

@@ -65,6 +65,33 @@ void add_geom_bounds(const mjModel* m, const mjData* d, int g, Bounds& bounds) {
   }
 }
 
+// Shadow-map texels wider than this (m) show self-shadowing "acne" on the floor.
+constexpr double kMaxTexel = 0.0022;
+
+// Radius of the sphere around a bounding box, with 5 cm to spare.
+double radius_of(const Bounds& b) {
+  double diagonal = 0.0;
+  for (int i = 0; i < 3; ++i) diagonal += (b.hi[i] - b.lo[i]) * (b.hi[i] - b.lo[i]);
+  return 0.5 * std::sqrt(diagonal) + 0.05;
+}
+
+// The shadow map's side (px) for a model: at least `least`, doubled (up to 4096) until a
+// map over the bodies standing at qpos0 has texels of at most kMaxTexel, so a tall
+// character (the 2.9 m bird robot) casts clean shadows too.
+int shadow_size_for(const mjModel* m, mjData* d, int least) {
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  mj_kinematics(m, d);
+  Bounds b;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] == 0 || m->geom_group[g] > 2) continue;
+    add_geom_bounds(m, d, g, b);
+  }
+  int size = std::max(least, 64);
+  if (b.empty()) return size;
+  while (size < 4096 && 2.0 * radius_of(b) / size > kMaxTexel) size *= 2;
+  return size;
+}
+
 int floor_geom(const mjModel* m) {
   for (int g = 0; g < m->ngeom; ++g) {
     // A plane's normal is its local z axis; world-body geoms are posed in the world frame,
@@ -356,13 +383,7 @@ struct OffscreenRenderer::Impl {
       }
       return b;
     };
-    const auto radius_of = [](const Bounds& b) {
-      double diagonal = 0.0;
-      for (int i = 0; i < 3; ++i) diagonal += (b.hi[i] - b.lo[i]) * (b.hi[i] - b.lo[i]);
-      return 0.5 * std::sqrt(diagonal) + 0.05;
-    };
-    // Past about 2.2 mm per texel the floor shows acne: then only the moving bodies count.
-    constexpr double kMaxTexel = 0.0022;  // m
+    // Past kMaxTexel per texel the floor shows acne: then only the moving bodies count.
     Bounds bodies = region(true);
     if (!bodies.empty() && 2.0 * radius_of(bodies) / gl.shadowSize > kMaxTexel) {
       bodies = region(false);
@@ -408,7 +429,7 @@ OffscreenRenderer::OffscreenRenderer(const mjModel* model, int width, int height
   m->vis.global.offwidth = width * ss;
   m->vis.global.offheight = height * ss;
   m->vis.quality.offsamples = 0;
-  m->vis.quality.shadowsize = std::max(style.shadow_size, 64);
+  m->vis.quality.shadowsize = shadow_size_for(m, r.data.get(), style.shadow_size);
   // Coarser built-in meshes than MuJoCo's defaults (28 slices, 16 stacks, 4 quads per box
   // side): llvmpipe lights per vertex and draws the scene up to three times with shadows, so
   // vertices dominate the cost; at these sizes the silhouettes look the same.

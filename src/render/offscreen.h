@@ -128,7 +128,7 @@ struct RenderStyle {
   Rgb band_dark{198, 198, 196};
   bool add_light = true;    // add a shadow-casting overhead light if the model has none
   bool shadows = true;      // about 3/4 of a picture's cost with llvmpipe
-  int shadow_size = 1024;   // px, side of the shadow map (the model's 4096 costs far more)
+  int shadow_size = 1024;   // px, least side of the shadow map (doubled for a tall character, up to 4096)
   int supersample = 2;      // render at this multiple of the size, then box-filter (1..4)
 };
 

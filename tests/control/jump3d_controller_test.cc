@@ -34,14 +34,14 @@ std::set<std::string> names_of(const std::vector<ParamSpec>& specs) {
 }
 
 // Per phase the sagittal groups but neck and wrists (stance phases name the tracked links
-// by what they are), and kp, kd of hips, knees and ankles; then eight more.
+// by what they are), and kp, kd of hips, knees and ankles; then nine more.
 TEST(Jump3dParameters, NamedAndRangedForTheHuman) {
   const TaskEvaluator ev(load_task(kRoot + "/tasks/jump_backwards.toml"));
   const auto specs = ev.parameters().specs();
-  EXPECT_EQ(specs.size(), 6u * (6 + 6) + 8);
+  EXPECT_EQ(specs.size(), 6u * (6 + 6) + 9);
   const auto names = names_of(specs);
   for (const char* n : {"start.pelvis", "crouch.knee", "crouch.foot", "crouch.chest", "extend.shoulder",
-                        "extend.lean", "rise.hip", "rise.ankle", "rise.waist", "fall.elbow", "land.kp_hip",
+                        "extend.lean", "extend.speed", "rise.hip", "rise.ankle", "rise.waist", "fall.elbow", "land.kp_hip",
                         "land.kd_ankle", "crouch.duration", "landing.velocity_gain"}) {
     EXPECT_TRUE(names.count(n)) << n;
   }
@@ -62,7 +62,7 @@ TEST(Jump3dParameters, NamedAndRangedForTheHuman) {
 TEST(Jump3dParameters, NamedAndRangedForTheRobot) {
   const TaskEvaluator ev(load_task(kRoot + "/tasks/robot_jump.toml"));
   const auto specs = ev.parameters().specs();
-  EXPECT_EQ(specs.size(), 6u * (4 + 6) + 8);
+  EXPECT_EQ(specs.size(), 6u * (4 + 6) + 9);
   const auto names = names_of(specs);
   // The bird's root is its body, "torso"; its feet pitch at the toe joints; its ankle is a
   // joint angle in every phase.

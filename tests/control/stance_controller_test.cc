@@ -232,6 +232,42 @@ TEST_P(Stance3d, StandingPoseHasTheComOverFlatFeet) {
   mj_deleteData(d);
 }
 
+// A push-off's speed: the virtual force's damping drives the COM towards the velocity set
+// with set_com_velocity, F_xy = M (com_kp e - com_kd (v - v_d)); a push is not held to the
+// support polygon, so the force differs by exactly M com_kd v_d.
+TEST_P(Stance3d, APushDrivesTheComTowardsItsSpeed) {
+  const Loaded c = load(GetParam());
+  SimWorker worker(c.model);
+  worker.reset();
+  mjModel* m = worker.model();
+  mjData* d = worker.data();
+  StanceController stance(c.body, m);
+  const std::vector<double> pose = stance.standing_pose(m);
+  mju_copy(d->qpos, pose.data(), m->nq);
+  mj_forward(m, d);
+  stance.reset(m, d);
+  JointDrive drive = drive_for(c.body);
+  // Settle onto the feet (the standing pose's soles touch the floor within a few steps).
+  for (int k = 0; k < 50; ++k) {
+    mj_step1(m, d);
+    stance.control(m, d, drive);
+    drive.apply(m, d);
+    mj_step2(m, d);
+  }
+  mj_forward(m, d);
+  stance.set_com_force(StanceController::ComForce::kPush);
+  stance.control(m, d, drive);
+  ASSERT_TRUE(stance.stance()[0] && stance.stance()[1]) << "both feet on the ground";
+  const std::array<double, 3> still = stance.virtual_force();
+  stance.set_com_velocity(3.0, -1.0);
+  stance.control(m, d, drive);
+  const std::array<double, 3> pushed = stance.virtual_force();
+  const double M = stance.mass(), kd = StanceGains{}.com_kd;
+  EXPECT_NEAR(pushed[0] - still[0], M * kd * 3.0, 1e-6 * M);
+  EXPECT_NEAR(pushed[1] - still[1], -M * kd * 1.0, 1e-6 * M);
+  EXPECT_DOUBLE_EQ(pushed[2], still[2]);
+}
+
 TEST_P(Stance3d, StandsTenSeconds) {
   const Loaded c = load(GetParam());
   const Outcome o = stand(c, {0, 0, 0}, 10.0);
