@@ -3,7 +3,7 @@
 # (-DDIVERSE_SANITIZE=ON) into ./build-asan, or the directory given, and runs the whole
 # test suite under them, the end-to-end tests included (docs/reliability.md, "Sanitizers").
 #
-#   scripts/sanitize.sh [BUILD_DIR] [CTEST_ARGS...]     e.g. scripts/sanitize.sh build-asan -R Rollout
+#   scripts/sanitize.sh [BUILD_DIR] [CTEST_ARGS...]     e.g. scripts/sanitize.sh -R Rollout
 #
 # JOBS sets the parallel jobs of the build and of ctest (default: the number of cores).
 # Every process the tests start, the `diverse` tool included, runs instrumented:
@@ -13,8 +13,11 @@
 # fails if a test fails or any report was written, and prints the reports and the figures.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
-build="${1:-$here/build-asan}"
-[ $# -gt 0 ] && shift
+build="$here/build-asan"
+if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
+  build="$1"
+  shift
+fi
 jobs="${JOBS:-$(nproc)}"
 
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDIVERSE_SANITIZE=ON \
