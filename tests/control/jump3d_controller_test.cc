@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <thread>
 
 #include "character/character.h"
 #include "core/error.h"
@@ -204,4 +205,31 @@ TEST(Jump3dController, HandAuthoredJumpsTakeOffWithinTheLimits) {
 }
 
 }  // namespace
+// Controllers of different characters built one after another on one thread (a worker
+// that evaluates both) give the same rollouts as on a thread of their own: the stance
+// controller's scratch data follows the model it serves.
+TEST(Jump3dRollouts, TheSameOnAThreadThatServedAnotherCharacter) {
+  const TaskEvaluator human(load_task(kRoot + "/tasks/jump_backwards.toml"));
+  const TaskEvaluator robot(load_task(kRoot + "/tasks/robot_jump.toml"));
+  const ParameterSet h = human.load_parameters(human.task().m0);
+  const ParameterSet r = robot.load_parameters(robot.task().m0);
+  auto run = [](const TaskEvaluator& ev, const ParameterSet& p) {
+    auto worker = ev.make_worker();
+    return ev.evaluate_normalized(p.normalized(), *worker, EvaluationOptions{});
+  };
+  Evaluation alone_h, alone_r;
+  std::thread([&] { alone_h = run(human, h); }).join();
+  std::thread([&] { alone_r = run(robot, r); }).join();
+  const Evaluation h1 = run(human, h), r1 = run(robot, r), h2 = run(human, h);
+  for (const Evaluation* e : {&h1, &h2}) {
+    EXPECT_EQ(e->constraint, alone_h.constraint);
+    EXPECT_EQ(e->summary.touchdown_feet_x, alone_h.summary.touchdown_feet_x);
+    EXPECT_EQ(e->summary.peak_com_z, alone_h.summary.peak_com_z);
+  }
+  EXPECT_EQ(r1.constraint, alone_r.constraint);
+  EXPECT_EQ(r1.summary.touchdown_feet_x, alone_r.summary.touchdown_feet_x);
+  EXPECT_EQ(alone_h.constraint, 0.0);
+  EXPECT_EQ(alone_r.constraint, 0.0);
+}
+
 }  // namespace diverse

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -106,6 +107,17 @@ class Faults : public ::testing::Test {
 };
 fs::path* Faults::reference_ = nullptr;
 
+// The full-disk preload in front of the tool. Under the sanitizer build (scripts/sanitize.sh)
+// AddressSanitizer wants its runtime first in the library list, so its link-order check is
+// turned off, added to the options the suite runs with rather than replacing them (those
+// send reports to files and set the leak and stack checks).
+std::string preload_env() {
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const std::string options = (asan != nullptr && asan[0] != '\0' ? std::string(asan) + ":" : std::string()) +
+                              "verify_asan_link_order=0";
+  return "'ASAN_OPTIONS=" + options + "' LD_PRELOAD=" + std::string(DIVERSE_FULL_DISK_PRELOAD);
+}
+
 TEST_F(Faults, KillWhileACheckpointIsBeingWritten) {
   const fs::path dir = scratch("mid_write");
   fs::create_directories(dir);
@@ -114,8 +126,7 @@ TEST_F(Faults, KillWhileACheckpointIsBeingWritten) {
   // whatever the machine's speed.
   const auto budget = static_cast<long long>(fs::file_size(*reference_ / "run.json") +
                                              fs::file_size(*reference_ / "checkpoint.json") * 3 / 2);
-  const std::string env = "ASAN_OPTIONS=verify_asan_link_order=0 LD_PRELOAD=" +
-                          std::string(DIVERSE_FULL_DISK_PRELOAD) + " DIVERSE_FULL_DISK_STALL=1 DIVERSE_FULL_DISK_DIR=" +
+  const std::string env = preload_env() + " DIVERSE_FULL_DISK_STALL=1 DIVERSE_FULL_DISK_DIR=" +
                           fs::canonical(dir).string() + " DIVERSE_FULL_DISK_BYTES=" + std::to_string(budget);
   ASSERT_TRUE(run_and_kill_when(dir, [](const fs::path& d) { return temporary_exists(d); }, env));
   // Whatever checkpoint is in place is whole (or, killed in the first one, there is none
@@ -147,8 +158,7 @@ TEST_F(Faults, DiskFullWhileCheckpointingKeepsTheLastCheckpoint) {
   const auto run_bytes = static_cast<long long>(fs::file_size(*reference_ / "run.json"));
   const auto checkpoint_bytes = static_cast<long long>(fs::file_size(*reference_ / "checkpoint.json"));
   const long long budget = run_bytes + checkpoint_bytes;
-  const std::string env = "ASAN_OPTIONS=verify_asan_link_order=0 LD_PRELOAD=" +
-                          std::string(DIVERSE_FULL_DISK_PRELOAD) + " DIVERSE_FULL_DISK_DIR=" +
+  const std::string env = preload_env() + " DIVERSE_FULL_DISK_DIR=" +
                           fs::canonical(dir).string() + " DIVERSE_FULL_DISK_BYTES=" + std::to_string(budget);
   const cli_test::CliResult r = cli_test::run_cli("run " + kArgs + " --out " + dir.string(), env);
   EXPECT_EQ(r.status, 2) << r.output;
