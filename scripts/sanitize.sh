@@ -6,7 +6,8 @@
 #   scripts/sanitize.sh [BUILD_DIR] [CTEST_ARGS...]     e.g. scripts/sanitize.sh -R Rollout
 #
 # JOBS sets the parallel jobs of the build and of ctest (default: the number of cores).
-# Every process the tests start, the `diverse` tool included, runs instrumented:
+# Every program of the project that the tests start, the `diverse` tool included, runs
+# instrumented:
 # AddressSanitizer and LeakSanitizer reports go to BUILD_DIR/sanitizer-reports/ (stderr
 # of a tool run by a test is often discarded), UndefinedBehaviorSanitizer reports to the
 # process's stderr, and any report stops the process with a failing exit code. The script
