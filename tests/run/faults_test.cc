@@ -131,7 +131,9 @@ TEST_F(Faults, KillWhileACheckpointIsBeingWritten) {
   ASSERT_TRUE(run_and_kill_when(dir, [](const fs::path& d) { return temporary_exists(d); }, env));
   // Whatever checkpoint is in place is whole (or, killed in the first one, there is none
   // and the resume starts again from run.json).
-  if (fs::exists(dir / "checkpoint.json")) EXPECT_GE(checkpoint_generation(dir), 0) << "a torn checkpoint";
+  if (fs::exists(dir / "checkpoint.json")) {
+    EXPECT_GE(checkpoint_generation(dir), 0) << "a torn checkpoint";
+  }
   expect_resumes_to_reference(dir);
 }
 
