@@ -250,29 +250,25 @@ struct OffscreenRenderer::Impl {
     }
   }
 
+  // A flat, unlit-looking decoration on the floor: a box from (x0, y0) to (x1, y1), or a
+  // disc, its top at z_top.
   void add_box(double x0, double x1, double y0, double y1, double z_top, Rgb color,
                float emission) {
-    if (scene.ngeom >= scene.maxgeom) return;
-    mjvGeom* geom = scene.geoms + scene.ngeom++;
     const mjtNum size[3] = {0.5 * (x1 - x0), 0.5 * (y1 - y0), 0.5 * kBandThickness};
-    const mjtNum pos[3] = {0.5 * (x0 + x1), 0.5 * (y0 + y1), z_top - 0.5 * kBandThickness};
-    const float rgba[4] = {color.r / 255.0f, color.g / 255.0f, color.b / 255.0f, 1.0f};
-    mjv_initGeom(geom, mjGEOM_BOX, size, pos, nullptr, rgba);
-    geom->category = mjCAT_DECOR;
-    geom->emission = emission;
-    geom->specular = 0.0f;
-    geom->reflectance = 0.0f;
+    add_floor_geom(mjGEOM_BOX, size, 0.5 * (x0 + x1), 0.5 * (y0 + y1), z_top, color, emission);
   }
-
-  // A flat disc on the floor, its top at z_top.
   void add_disc(double x, double y, double radius, double z_top, Rgb color, float emission) {
-    if (scene.ngeom >= scene.maxgeom) return;
-    mjvGeom* geom = scene.geoms + scene.ngeom++;
     // mjv_initGeom reads a cylinder's size as the model does: radius, half-height.
     const mjtNum size[3] = {radius, 0.5 * kBandThickness, 0};
+    add_floor_geom(mjGEOM_CYLINDER, size, x, y, z_top, color, emission);
+  }
+  void add_floor_geom(int type, const mjtNum size[3], double x, double y, double z_top, Rgb color,
+                      float emission) {
+    if (scene.ngeom >= scene.maxgeom) return;
+    mjvGeom* geom = scene.geoms + scene.ngeom++;
     const mjtNum pos[3] = {x, y, z_top - 0.5 * kBandThickness};
     const float rgba[4] = {color.r / 255.0f, color.g / 255.0f, color.b / 255.0f, 1.0f};
-    mjv_initGeom(geom, mjGEOM_CYLINDER, size, pos, nullptr, rgba);
+    mjv_initGeom(geom, type, size, pos, nullptr, rgba);
     geom->category = mjCAT_DECOR;
     geom->emission = emission;
     geom->specular = 0.0f;

@@ -14,22 +14,31 @@ namespace diverse {
 namespace {
 namespace fs = std::filesystem;
 
+// A planar-human task NAME in DIR with jump_forward's constraints (land 1 m ahead), whose
+// [seed] table starts from BASE (a file under the source tree) and adds SEED_EXTRA.
+fs::path write_forward_task(const fs::path& dir, const std::string& name, const std::string& base,
+                            const std::string& seed_extra = "") {
+  const std::string source = DIVERSE_SOURCE_DIR;
+  const fs::path file = dir / (name + ".toml");
+  write_file_atomic(file,
+                    "name = \"" + name + "\"\n"
+                    "character = \"" + source + "/assets/characters/human2d.xml\"\n"
+                    "metric = \"md\"\n"
+                    "variations = 4\n"
+                    "m0 = \"" + name + ".m0.json\"\n"
+                    "[controller]\ntype = \"jump2d\"\n"
+                    "[constraints]\nweight = 5000.0\nfall_penalty = 100000.0\nlanding = { center = 1.0, half_width = 0.15 }\n"
+                    "[seed]\nbase = \"" + source + "/" + base + "\"\ngenerations = 1\n" + seed_extra);
+  return file;
+}
+
 TEST(SeedMotionCli, AShortSearchThatFailsWritesAPartialFileNotTheM0) {
   const fs::path dir = fs::temp_directory_path() / "diverse_seed_motion_cli_test";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::string source = DIVERSE_SOURCE_DIR;
-  // jump_forward's constraints, starting from the hand-authored small in-place jump, which
-  // one generation of search cannot turn into a 1 m forward jump.
-  write_file_atomic(dir / "short.toml",
-                    "name = \"short\"\n"
-                    "character = \"" + source + "/assets/characters/human2d.xml\"\n"
-                    "metric = \"md\"\n"
-                    "variations = 4\n"
-                    "m0 = \"short.m0.json\"\n"
-                    "[controller]\ntype = \"jump2d\"\n"
-                    "[constraints]\nweight = 5000.0\nfall_penalty = 100000.0\nlanding = { center = 1.0, half_width = 0.15 }\n"
-                    "[seed]\nbase = \"" + source + "/tasks/base_jump.json\"\ngenerations = 1\n");
+  // Starting from the hand-authored small in-place jump, which one generation of search
+  // cannot turn into a 1 m forward jump.
+  write_forward_task(dir, "short", "tasks/base_jump.json");
   const auto r = cli_test::run_cli("seed-motion " + (dir / "short.toml").string() + " --threads 2");
   EXPECT_NE(r.status, 0) << r.output;
   EXPECT_FALSE(fs::exists(dir / "short.m0.json"));
@@ -46,18 +55,9 @@ TEST(SeedMotionCli, EveryStageIsKeptAndASearchGoesOnFromALaterStage) {
   const fs::path dir = fs::temp_directory_path() / ("diverse_seed_motion_cli_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const std::string source = DIVERSE_SOURCE_DIR;
   // Stage 0 lands near where jump_high's input motion lands (0.13 m), which it meets at
   // once; stage 1 asks for 1 m, which one generation does not reach.
-  write_file_atomic(dir / "far.toml",
-                    "name = \"far\"\n"
-                    "character = \"" + source + "/assets/characters/human2d.xml\"\n"
-                    "metric = \"md\"\n"
-                    "variations = 4\n"
-                    "m0 = \"far.m0.json\"\n"
-                    "[controller]\ntype = \"jump2d\"\n"
-                    "[constraints]\nweight = 5000.0\nfall_penalty = 100000.0\nlanding = { center = 1.0, half_width = 0.15 }\n"
-                    "[seed]\nbase = \"" + source + "/tasks/jump_high.m0.json\"\ngenerations = 1\ndistances = [0.1, 1.0]\n");
+  write_forward_task(dir, "far", "tasks/jump_high.m0.json", "distances = [0.1, 1.0]\n");
   const std::string task = (dir / "far.toml").string();
   const auto first = cli_test::run_cli("seed-motion " + task + " --threads 2");
   EXPECT_NE(first.status, 0) << first.output;
