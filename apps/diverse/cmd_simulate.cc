@@ -80,10 +80,10 @@ void run(const SimulateArgs& args) {
     }
     std::printf("%zu steps, %d simulation steps, %.3f s\n", s.walk.steps.size(), e.stats.steps, e.stats.time);
   } else {
-    std::printf("peak COM %.3f m, feet touch down at x %.3f y %.3f z %.3f m and end at x %.3f y %.3f z %.3f m, "
+    std::printf("peak COM %.3f m (standing %.3f m), feet touch down at x %.3f y %.3f z %.3f m and end at x %.3f y %.3f z %.3f m, "
                 "rotation %.1f deg (flight %.1f), largest forward pitch %.1f deg, min obstacle distance %.3f m, "
                 "%d steps, %.3f s\n",
-                s.peak_com_z, s.touchdown_feet_x, s.touchdown_feet_y, s.touchdown_feet_z, s.feet_x, s.feet_y,
+                s.peak_com_z, s.standing_com_z, s.touchdown_feet_x, s.touchdown_feet_y, s.touchdown_feet_z, s.feet_x, s.feet_y,
                 s.feet_z, s.rotation_total * 180 / M_PI, s.rotation_flight * 180 / M_PI,
                 s.max_forward_pitch * 180 / M_PI, s.min_clearance, e.stats.steps, e.stats.time);
   }

@@ -85,8 +85,10 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
   const auto w = static_cast<std::size_t>(worker);
   auto outcome = std::make_shared<MotionOutcome>();
   Evaluation e;
+  EvaluationOptions options;
+  options.half_timestep_check = true;  // when the task asks for it
   if (!vary_shape_) {
-    e = evaluator_->evaluate_normalized(x, *workers_.at(w));
+    e = evaluator_->evaluate_normalized(x, *workers_.at(w), options);
     outcome->scales = base_scales_;
     outcome->features.link_lengths = base_link_lengths_;
   } else {
@@ -116,7 +118,7 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
         slot.scene = evaluator_->shaped_scene(scales);
         slot.worker = std::make_unique<SimWorker>(slot.scene->model);
       }
-      e = evaluator_->evaluate(control, *slot.scene, *slot.worker);
+      e = evaluator_->evaluate(control, *slot.scene, *slot.worker, options);
     }
   }
   outcome->constraint = e.constraint;

@@ -28,7 +28,8 @@ nlohmann::json summary_json(const MotionSummary& s) {
   nlohmann::json j = {{"unstable", s.unstable},           {"took_off", s.took_off},
           {"landed", s.landed},               {"settled", s.settled},
           {"fell", s.fell},                   {"fall_reason", s.fall_reason},
-          {"peak_com_z", s.peak_com_z},       {"feet_x", s.feet_x},
+          {"peak_com_z", s.peak_com_z},       {"standing_com_z", s.standing_com_z},
+          {"feet_x", s.feet_x},
           {"feet_y", s.feet_y},               {"feet_z", s.feet_z},
           {"touchdown_feet_x", s.touchdown_feet_x}, {"touchdown_feet_y", s.touchdown_feet_y},
           {"touchdown_feet_z", s.touchdown_feet_z}, {"rotation_total", s.rotation_total},
@@ -134,6 +135,7 @@ Evaluation write_motion(const TaskEvaluator& evaluator, const ParameterSet& para
   StepRecorder record;
   EvaluationOptions options;
   options.recorder = &record;
+  options.half_timestep_check = true;  // when the task asks for it: as the optimizer saw it
   std::shared_ptr<const SharedModel> model;
   const Evaluation e = evaluator.evaluate_named(parameters, options, &model);
   // The exact MJCF text the model was compiled from: loaded by any MuJoCo program it

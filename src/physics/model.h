@@ -50,8 +50,8 @@ class SimWorker {
   SimWorker(const SimWorker&) = delete;
   SimWorker& operator=(const SimWorker&) = delete;
 
-  // Restores the private model's writable parameters (dof_damping) from the shared
-  // model and resets mjData to qpos0 with zero velocity, time and warnings.
+  // Restores the private model's writable parameters (dof_damping, opt.timestep) from
+  // the shared model and resets mjData to qpos0 with zero velocity, time and warnings.
   void reset();
 
   const SharedModel& shared() const { return *shared_; }

@@ -32,6 +32,17 @@ std::string numbered(char prefix, std::size_t i) {
   return s;
 }
 std::string label(std::size_t i) { return numbered('M', i); }
+
+// The half-timestep check of a re-simulated motion (task/constraints.h): null when the
+// task does not ask for it or the motion did not meet the task at its own timestep;
+// otherwise whether it holds, with the term's violation and penalty.
+nlohmann::json half_timestep_json(const Evaluation& e) {
+  for (const ConstraintTerm& t : e.report.terms) {
+    if (t.name == "half_timestep")
+      return {{"holds", t.penalty == 0}, {"violation", t.violation}, {"penalty", t.penalty}};
+  }
+  return nullptr;
+}
 std::string stem(std::size_t i) { return numbered('m', i); }
 
 }  // namespace
@@ -127,6 +138,7 @@ void write_run_outputs(const RunOutputs& o) {
                        {"failed", outcome.failed},
                        {"landing_x", outcome.landing_x},
                        {"peak_com_z", outcome.peak_com_z},
+                       {"half_timestep", half_timestep_json(evaluations[i])},
                        {"shape_scales", scales},
                        {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())},
                        {"file", "motions/" + stem(i) + ".json"}});

@@ -4,6 +4,36 @@
 #include <cmath>
 
 namespace diverse {
+namespace {
+
+// The peak COM height the task asks for (m above the floor).
+double peak_height_required(const TaskConstraints& c, const MotionSummary& motion) {
+  return c.peak_height_min + (c.peak_height_relative ? motion.standing_com_z : 0.0);
+}
+
+// The root's rotation between take-off and touch-down in the direction of the turns (rad).
+double flight_turn(const TaskConstraints& c, const MotionSummary& motion) {
+  return c.rotation_turns < 0 ? -motion.rotation_flight : motion.rotation_flight;
+}
+
+}  // namespace
+
+double landing_shift(const MotionSummary& a, const MotionSummary& b) {
+  return std::max(std::hypot(a.touchdown_feet_x - b.touchdown_feet_x, a.touchdown_feet_y - b.touchdown_feet_y),
+                  std::hypot(a.feet_x - b.feet_x, a.feet_y - b.feet_y));
+}
+
+ConstraintTerm half_timestep_term(const Task& task, const MotionSummary& coarse,
+                                  const MotionSummary& fine, double fine_c) {
+  const bool both_landed = coarse.landed && fine.landed && !coarse.fell && !fine.fell &&
+                           !coarse.unstable && !fine.unstable;
+  const double d = both_landed ? std::max(0.0, landing_shift(coarse, fine) - kTimestepAgreement) : 0.0;
+  ConstraintTerm term;
+  term.name = "half_timestep";
+  term.penalty = fine_c + task.constraints.weight * d * d;
+  term.violation = fine_c > 0 ? std::max(1.0, d) : d;
+  return term;
+}
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
   if (task.walk.enabled) return walk_constraints(task, motion);
@@ -58,12 +88,17 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
               }));
   }
   if (c.peak_height) {
-    quadratic("peak_height", std::max(0.0, c.peak_height_min - motion.peak_com_z));
+    quadratic("peak_height", std::max(0.0, peak_height_required(c, motion) - motion.peak_com_z));
   }
   if (c.rotation) {
     const double d = std::max(0.0, std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns) -
                                        c.rotation_tolerance);
     add("rotation", d, d > 0 ? c.rotation_penalty + c.weight * d * d : 0);
+    if (c.min_flight_rotation > 0) {
+      // A motion that never landed has no rotation in the air; the fall term covers it.
+      const double turned = motion.landed ? flight_turn(c, motion) : c.min_flight_rotation;
+      quadratic("flight_rotation", motion.landed ? std::max(0.0, c.min_flight_rotation - turned) : 0.0);
+    }
   }
   if (c.pitch) {
     quadratic("pitch", std::max(0.0, motion.max_forward_pitch - c.max_pitch));
@@ -94,10 +129,12 @@ double constraint_margin(const Task& task, const MotionSummary& motion) {
     if (c.min_length) margin = std::min(margin, x - c.min_length_value);
   }
   if (c.clearance) margin = std::min(margin, motion.min_clearance - c.min_clearance);
-  if (c.peak_height) margin = std::min(margin, motion.peak_com_z - c.peak_height_min);
+  if (c.peak_height) margin = std::min(margin, motion.peak_com_z - peak_height_required(c, motion));
   if (c.rotation) {
     const double miss = std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns);
     margin = std::min(margin, 0.2 * (c.rotation_tolerance - miss));
+    if (c.min_flight_rotation > 0)
+      margin = std::min(margin, 0.2 * (flight_turn(c, motion) - c.min_flight_rotation));
   }
   return margin;
 }

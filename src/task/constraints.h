@@ -8,7 +8,14 @@
 // Never leaving the ground, or never landing, counts as a fall. A rollout whose
 // simulation blew up costs 3 * fall_penalty. The backflip's rotation requirement adds
 // rotation_penalty plus K_c d^2 when the root's rotation from start to end misses
-// turns * 2 pi by more than the tolerance.
+// turns * 2 pi by more than the tolerance; a minimum rotation in the air (min_flight)
+// adds K_c d^2 for a shortfall of d rad between take-off and the first touch-down.
+//
+// The half-timestep check (half_timestep): a motion that meets the task is simulated
+// again with the timestep halved (TaskEvaluator, EvaluationOptions::half_timestep_check);
+// the term "half_timestep" adds that rollout's C, plus K_c d^2 when the feet land (at
+// touch-down or at rest) further than kTimestepAgreement + d from where they did at the
+// task's timestep. A motion that exploits integration error does not meet the task.
 //
 // Where the character lands (the landing box, on_box, min_length) is checked twice: at
 // the first touch-down after flight and at rest, and the larger violation counts. The
@@ -35,6 +42,7 @@ struct MotionSummary {
   std::string fall_reason;    // empty unless fell
   double fall_progress = 1;   // how far the motion got before falling, in [0, 1]
   double peak_com_z = 0;      // m, highest whole-body COM during flight
+  double standing_com_z = 0;  // m, the whole-body COM in the start pose, before anything moves
   double feet_x = 0, feet_y = 0, feet_z = 0;   // m, mean of the foot centres at the end
   double touchdown_feet_x = 0, touchdown_feet_y = 0, touchdown_feet_z = 0;  // m, the same at the first touch-down
   double rotation_total = 0;  // rad, root pitch at the end minus at the start
@@ -58,6 +66,21 @@ struct ConstraintReport {
 };
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion);
+
+// Two simulations of one motion at different timesteps agree when the feet land within
+// this distance (m) of the same spot, at touch-down and at rest.
+constexpr double kTimestepAgreement = 0.03;
+
+// The larger of the horizontal distances between a's and b's feet at touch-down and at
+// rest (m).
+double landing_shift(const MotionSummary& a, const MotionSummary& b);
+
+// The half-timestep term for a motion that meets the task at its timestep (`coarse`),
+// given the same motion simulated with the timestep halved (`fine`, its C `fine_c`):
+// penalty fine_c + K_c d^2, d the landing shift beyond kTimestepAgreement (0 when either
+// did not land); violation d, or 1 when the fine motion does not meet the task.
+ConstraintTerm half_timestep_term(const Task& task, const MotionSummary& coarse,
+                                  const MotionSummary& fine, double fine_c);
 
 // How far inside the allowed region the motion is: the smallest slack (m) over the
 // task's geometric constraints (landing box, box edges, clearance, length, peak height;

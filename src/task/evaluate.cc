@@ -41,6 +41,7 @@ class JumpHooks : public StepHooks {
     if (first_) {
       pitch0_ = pitch;
       first_ = false;
+      s.standing_com_z = controller_.com()[2];
       if (body_.root == RootKind::kFree) {
         // The root's standing "up" and forward axes in its own frame (from qpos0).
         const double* q0 = m->qpos0 + body_.root_qpos + 3;
@@ -283,6 +284,10 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
   Evaluation e;
   worker.reset();
   mjModel* m = worker.model();
+  if (!(options.timestep_scale > 0) || !std::isfinite(options.timestep_scale)) {
+    throw std::logic_error("TaskEvaluator::evaluate: timestep_scale must be positive");
+  }
+  m->opt.timestep *= options.timestep_scale;
   const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
   JointDrive drive = make_drive(body);
   controller->start_state(m, worker.data());
@@ -310,6 +315,16 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
       auto poses = sample_poses(e, phase, taus, worker);
       e.poses.insert(e.poses.end(), poses.begin(), poses.end());
     }
+  }
+  if (options.half_timestep_check && task_.constraints.half_timestep && !e.failed && e.constraint == 0) {
+    EvaluationOptions fine_options;
+    fine_options.samples_per_phase = 0;
+    fine_options.timestep_scale = 0.5 * options.timestep_scale;
+    const Evaluation fine = evaluate_on(values, body, worker, fine_options);
+    const ConstraintTerm term = half_timestep_term(task_, e.summary, fine.summary, fine.constraint);
+    e.report.terms.push_back(term);
+    e.report.total += term.penalty;
+    e.constraint = e.report.total;
   }
   return e;
 }

@@ -47,6 +47,15 @@ struct PoseSample {
 struct EvaluationOptions {
   int samples_per_phase = 10;        // poses per airborne phase (a walk: per state) at (k + 0.5) / n; 0 = none
   StepRecorder* recorder = nullptr;  // exact-replay record (off in the optimizer)
+  // The rollout runs at the model's timestep times this (the worker's model copy is
+  // changed for the rollout only; SimWorker::reset restores it).
+  double timestep_scale = 1.0;
+  // When the task asks for the half-timestep check ([constraints] half_timestep, a jump
+  // task) and the motion meets the task, simulate it again on the same worker with the
+  // timestep halved and add the term "half_timestep" (task/constraints.h) to its report
+  // and C. Off by default: the optimizer's samples, `diverse simulate` and the motion
+  // files of a run ask for it; the input-motion search checks both timesteps itself.
+  bool half_timestep_check = false;
 };
 
 struct Evaluation {

@@ -327,11 +327,6 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   return result;
 }
 
-double landing_shift(const MotionSummary& a, const MotionSummary& b) {
-  return std::max(std::hypot(a.touchdown_feet_x - b.touchdown_feet_x, a.touchdown_feet_y - b.touchdown_feet_y),
-                  std::hypot(a.feet_x - b.feet_x, a.feet_y - b.feet_y));
-}
-
 std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int count,
                                      std::uint64_t seed) {
   std::vector<Eigen::VectorXd> out;

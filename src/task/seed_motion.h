@@ -49,13 +49,8 @@
 
 namespace diverse {
 
-// The landing spots of an input motion at the task's timestep and at half of it differ
-// by at most this much (m).
-constexpr double kTimestepAgreement = 0.03;
-
-// The larger of the horizontal distances between a's and b's feet at touch-down and at
-// rest (m).
-double landing_shift(const MotionSummary& a, const MotionSummary& b);
+// The landing spots of an input motion at the task's timestep and at half of it differ by
+// at most kTimestepAgreement (task/constraints.h, with landing_shift()).
 
 struct SeedOptions {
   int threads = 1;

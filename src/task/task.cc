@@ -80,7 +80,7 @@ void require_object(const TomlReader& r, const Task& task, const char* key, cons
 
 void read_constraints(const TomlReader& r, Task& task) {
   r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
-          "peak_height", "rotation", "pitch"});
+          "peak_height", "rotation", "pitch", "half_timestep"});
   TaskConstraints& c = task.constraints;
   c.weight = r.number("weight", 1e-6, 1e9);
   c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
@@ -122,17 +122,31 @@ void read_constraints(const TomlReader& r, Task& task) {
   }
   if (auto t = r.table("peak_height", false)) {
     TomlReader s = r.sub("peak_height", *t);
-    s.only({"min"});
+    s.only({"min", "above_standing"});
     c.peak_height = true;
-    c.peak_height_min = s.number("min", 0, 5);
+    if (s.has("above_standing")) {
+      if (s.has("min")) s.fail("min", "expected either min (m above the floor) or above_standing (m above the standing COM), not both");
+      c.peak_height_relative = true;
+      c.peak_height_min = s.number("above_standing", 0, 5);
+    } else {
+      c.peak_height_min = s.number("min", 0, 5);
+    }
   }
   if (auto t = r.table("rotation", false)) {
     TomlReader s = r.sub("rotation", *t);
-    s.only({"turns", "tolerance", "penalty"});
+    s.only({"turns", "tolerance", "penalty", "min_flight"});
     c.rotation = true;
     c.rotation_turns = s.number("turns", -3, 3);
     c.rotation_tolerance = s.number("tolerance", 0.01, 3.14);
     c.rotation_penalty = s.number("penalty", 0, 1e12);
+    const double most = 2 * M_PI * std::fabs(c.rotation_turns) + c.rotation_tolerance;
+    c.min_flight_rotation = s.number("min_flight", 0, 20, 0.0);
+    if (c.min_flight_rotation > most) {
+      std::ostringstream what;
+      what << "expected a rotation in the air (rad) no larger than the whole turn allows, 2 pi |turns| + tolerance = "
+           << most << ", got " << c.min_flight_rotation;
+      s.fail("min_flight", what.str());
+    }
   }
   if (auto t = r.table("pitch", false)) {
     TomlReader s = r.sub("pitch", *t);
@@ -140,6 +154,7 @@ void read_constraints(const TomlReader& r, Task& task) {
     c.pitch = true;
     c.max_pitch = s.number("max", 0.01, 3.14);
   }
+  c.half_timestep = r.boolean("half_timestep", false);
 }
 
 void read_simulation(const TomlReader& r, Task& task) {

@@ -58,14 +58,24 @@ struct TaskConstraints {
   // Minimum jump length: feet at x >= min_length.
   bool min_length = false;
   double min_length_value = 0;  // m
-  // Minimum peak height of the whole-body COM.
+  // Minimum peak height of the whole-body COM during flight: above the floor (`min`), or,
+  // with peak_height_relative (`above_standing`), above the COM's height in the start
+  // pose, so that a body with longer legs has to rise as far as any other.
   bool peak_height = false;
   double peak_height_min = 0;  // m
+  bool peak_height_relative = false;
   // Root rotation from start to end within turns * 2 pi +- tolerance.
   bool rotation = false;
   double rotation_turns = 1;        // full turns, positive = backwards
   double rotation_tolerance = 0.5;  // rad
   double rotation_penalty = 100000; // constant added when violated
+  // The root turns at least this much (rad, in the direction of rotation_turns) between
+  // take-off and the first touch-down: a flip turns in the air, not on its feet. 0 = none.
+  double min_flight_rotation = 0;
+  // Every motion that meets the task is simulated again with the timestep halved and
+  // meets it only if it still does there, its feet landing within kTimestepAgreement of
+  // the same spot (task/constraints.h): a motion may not hinge on integration error.
+  bool half_timestep = false;
   // The root's forward pitch (rad, from standing, about the world's lateral axis) at most
   // `max_pitch` throughout the motion (the bird robot's long jump).
   bool pitch = false;

@@ -100,6 +100,23 @@ TEST_P(M0, TimestepHalvedLandsNearby) {
   EXPECT_FALSE(b.e.fell) << b.e.summary.fall_reason;
 }
 
+// Where the task asks for the half-timestep check, M0 passes it: C stays 0 with the check's
+// rollout at half the timestep added.
+TEST_P(M0, PassesTheHalfTimestepCheck) {
+  REQUIRE_M0(GetParam());
+  const Task task = load_task(kTasks + GetParam() + ".toml");
+  if (!task.constraints.half_timestep) GTEST_SKIP() << GetParam() << " does not ask for the check";
+  const TaskEvaluator ev(task);
+  auto worker = ev.make_worker();
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  options.half_timestep_check = true;
+  const Evaluation e = ev.evaluate(ev.load_parameters(task.m0).values(), *worker, options);
+  ASSERT_FALSE(e.report.terms.empty());
+  EXPECT_EQ(e.report.terms.back().name, "half_timestep");
+  EXPECT_EQ(e.constraint, 0.0) << GetParam() << ": half-timestep violation " << e.report.terms.back().violation;
+}
+
 // Perturbations of the normalized parameters (the first `count` of those `diverse
 // seed-motion TASK --robustness-check` measures): some of them must still meet the task,
 // so the diversity optimizer finds feasible samples around M0 from the start. The bounds

@@ -299,6 +299,97 @@ TEST(Constraints, LandingIsMeasuredAtTouchdownAndAtRest) {
   EXPECT_NEAR(evaluate_constraints(over, o).total, 5000 * 0.1 * 0.1, 1e-9);
 }
 
+// A flip turns in the air: the root's rotation between take-off and the first touch-down
+// (in the direction of the turns) short of min_flight by d costs K_c d^2, and counts in
+// the margin at 0.2 m per rad. A motion that never landed has no flight to measure (its
+// fall is the penalty).
+TEST_F(TaskFileTest, MinimumRotationInTheAir) {
+  const std::string flip = valid_text() + "rotation = { turns = 1.0, tolerance = 0.5, penalty = 100000.0, min_flight = 5.0 }\n";
+  const Task t = load_task(write(flip));
+  EXPECT_DOUBLE_EQ(t.constraints.min_flight_rotation, 5.0);
+  MotionSummary m;
+  m.took_off = m.landed = m.settled = true;
+  m.feet_x = m.touchdown_feet_x = 1.0;
+  m.rotation_total = 2 * M_PI;
+  m.rotation_flight = 5.1;
+  EXPECT_EQ(evaluate_constraints(t, m).total, 0.0);
+  EXPECT_NEAR(constraint_margin(t, m), 0.2 * 0.1, 1e-12);
+  m.rotation_flight = 4.7;  // 0.3 rad short, the whole turn still within its tolerance
+  ConstraintReport r = evaluate_constraints(t, m);
+  EXPECT_NEAR(r.total, 5000 * 0.3 * 0.3, 1e-9);
+  EXPECT_EQ(r.terms.back().name, "flight_rotation");
+  EXPECT_NEAR(r.terms.back().violation, 0.3, 1e-12);
+  m.landed = false;
+  r = evaluate_constraints(t, m);
+  EXPECT_EQ(r.terms.back().penalty, 0.0);
+
+  // A front flip (negative turns) turns the other way in the air.
+  const Task front = load_task(write(replace(flip, "turns = 1.0", "turns = -1.0")));
+  m.landed = true;
+  m.rotation_total = -2 * M_PI;
+  m.rotation_flight = -5.2;
+  EXPECT_EQ(evaluate_constraints(front, m).total, 0.0);
+  m.rotation_flight = 5.2;  // the wrong way round
+  EXPECT_NEAR(evaluate_constraints(front, m).terms.back().penalty, 5000 * 10.2 * 10.2, 1e-6);
+
+  // No more than the whole turn allows.
+  EXPECT_EQ(error_of(replace(flip, "min_flight = 5.0", "min_flight = 7.0")),
+            ": constraints.rotation.min_flight: expected a rotation in the air (rad) no larger than the "
+            "whole turn allows, 2 pi |turns| + tolerance = 6.78319, got 7");
+  EXPECT_EQ(error_of(replace(flip, "min_flight = 5.0", "min_flight = -1")),
+            ": constraints.rotation.min_flight: expected a number in [0, 20], got -1");
+}
+
+// The peak height of a jump is measured from the floor (min) or from the centre of mass
+// standing in the start pose (above_standing): then a body that stands taller has to rise
+// as far as any other, rather than meeting the height by standing taller.
+TEST_F(TaskFileTest, PeakHeightAboveTheStandingCom) {
+  const Task absolute = load_task(write(valid_text() + "peak_height = { min = 1.2 }\n"));
+  const Task relative = load_task(write(valid_text() + "peak_height = { above_standing = 0.3 }\n"));
+  EXPECT_FALSE(absolute.constraints.peak_height_relative);
+  EXPECT_TRUE(relative.constraints.peak_height_relative);
+  MotionSummary m;
+  m.took_off = m.landed = m.settled = true;
+  m.feet_x = m.touchdown_feet_x = 1.0;
+  m.standing_com_z = 0.95;
+  m.peak_com_z = 1.21;
+  EXPECT_EQ(evaluate_constraints(absolute, m).total, 0.0);
+  EXPECT_NEAR(evaluate_constraints(relative, m).total, 5000 * 0.04 * 0.04, 1e-9);  // rose 0.26 m
+  EXPECT_NEAR(constraint_margin(relative, m), -0.04, 1e-12);
+  m.standing_com_z = 0.85;  // a shorter body: the same peak is a higher jump
+  EXPECT_EQ(evaluate_constraints(relative, m).total, 0.0);
+  EXPECT_NEAR(constraint_margin(relative, m), 0.06, 1e-12);
+  EXPECT_EQ(error_of(valid_text() + "peak_height = { min = 1.2, above_standing = 0.3 }\n"),
+            ": constraints.peak_height.min: expected either min (m above the floor) or above_standing (m above "
+            "the standing COM), not both");
+  EXPECT_EQ(error_of(valid_text() + "half_timestep = 1\n"),
+            ": constraints.half_timestep: expected true or false");
+  EXPECT_TRUE(load_task(write(valid_text() + "half_timestep = true\n")).constraints.half_timestep);
+  EXPECT_FALSE(load_task(write(valid_text())).constraints.half_timestep);
+}
+
+// The half-timestep term: the fine rollout's C, plus K_c d^2 for landing spots more than
+// kTimestepAgreement + d apart; its violation is 1 when the fine rollout misses the task.
+TEST(Constraints, HalfTimestepTerm) {
+  const Task t = load_task(kTasks + "jump_forward.toml");
+  MotionSummary coarse, fine;
+  coarse.took_off = coarse.landed = coarse.settled = true;
+  coarse.feet_x = coarse.touchdown_feet_x = 1.0;
+  fine = coarse;
+  fine.touchdown_feet_x = 1.02;  // within 3 cm
+  ConstraintTerm term = half_timestep_term(t, coarse, fine, 0.0);
+  EXPECT_EQ(term.name, "half_timestep");
+  EXPECT_EQ(term.penalty, 0.0);
+  fine.feet_x = 1.08;  // 8 cm apart at rest: 5 cm too far
+  term = half_timestep_term(t, coarse, fine, 0.0);
+  EXPECT_NEAR(term.violation, 0.05, 1e-12);
+  EXPECT_NEAR(term.penalty, 5000 * 0.05 * 0.05, 1e-9);
+  fine.fell = true;  // a fall has no landing to compare; its C is the penalty
+  term = half_timestep_term(t, coarse, fine, 100000.0);
+  EXPECT_EQ(term.violation, 1.0);
+  EXPECT_EQ(term.penalty, 100000.0);
+}
+
 // 3D landings are measured in the ground plane: within the disc's radius of its centre, at
 // touch-down and at rest; the robot's forward pitch beyond its limit costs K_c d^2.
 TEST(Constraints, LandingDiscAndPitchLimit) {

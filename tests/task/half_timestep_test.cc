@@ -1,0 +1,159 @@
+// The half-timestep check ([constraints] half_timestep, task/constraints.h): a motion that
+// meets its task is simulated again on the same worker with the timestep halved, and meets
+// the task only if it still does there and lands within kTimestepAgreement of the same
+// spot. Checked on real rollouts: a motion that meets the task at both timesteps but lands
+// 11 cm apart, the committed high jump, the equivalence with a model compiled at the
+// halved timestep, the worker's timestep restored for the next rollout, and the optimizer's
+// outcomes carrying the term.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "eval/motion_problem.h"
+#include "task/evaluate.h"
+#include "task/seed_motion.h"
+
+namespace diverse {
+namespace {
+
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
+const std::string kLandsApart = std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_high_lands_apart.json";
+
+const ConstraintTerm* find_term(const Evaluation& e, const std::string& name) {
+  for (const ConstraintTerm& t : e.report.terms)
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+EvaluationOptions checked() {
+  EvaluationOptions o;
+  o.samples_per_phase = 0;
+  o.half_timestep_check = true;
+  return o;
+}
+
+// The five 2D jump tasks ask for the check.
+TEST(HalfTimestep, TheTwoDimensionalJumpTasksAskForIt) {
+  for (const char* name : {"backflip", "jump_forward", "jump_onto", "jump_over", "jump_high"})
+    EXPECT_TRUE(load_task(kTasks + name + ".toml").constraints.half_timestep) << name;
+}
+
+// A perturbation of the high jump's input motion meets the task at 2 ms and at 1 ms but its
+// feet come to rest 11 cm apart at the two: with the check it does not meet the task, by
+// exactly K_c (shift - 3 cm)^2; without it (the default) C = 0.
+TEST(HalfTimestep, LandingApartAtHalfTheTimestepViolatesTheTask) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet p = ev.load_parameters(kLandsApart);
+  auto worker = ev.make_worker();
+  EvaluationOptions plain;
+  plain.samples_per_phase = 0;
+  const Evaluation coarse = ev.evaluate(p.values(), *worker, plain);
+  ASSERT_EQ(coarse.constraint, 0.0);
+  EXPECT_EQ(find_term(coarse, "half_timestep"), nullptr);
+
+  EvaluationOptions fine_options = plain;
+  fine_options.timestep_scale = 0.5;
+  const Evaluation fine = ev.evaluate(p.values(), *worker, fine_options);
+  ASSERT_EQ(fine.constraint, 0.0);
+  const double shift = landing_shift(coarse.summary, fine.summary);
+  ASSERT_GT(shift, 0.08);
+
+  const Evaluation e = ev.evaluate(p.values(), *worker, checked());
+  const ConstraintTerm* term = find_term(e, "half_timestep");
+  ASSERT_NE(term, nullptr);
+  const double d = shift - kTimestepAgreement;
+  EXPECT_NEAR(term->violation, d, 1e-12);
+  EXPECT_NEAR(e.constraint, task.constraints.weight * d * d, 1e-9);
+  EXPECT_GT(e.constraint, 0.0);
+  // The coarse rollout's own outcome is unchanged by the check.
+  EXPECT_EQ(e.summary.feet_x, coarse.summary.feet_x);
+  EXPECT_EQ(e.stats.steps, coarse.stats.steps);
+}
+
+// The committed high jump holds at half the timestep: the term is there and costs nothing.
+TEST(HalfTimestep, TheHighJumpsInputMotionHolds) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(ev.load_parameters(task.m0).values(), *worker, checked());
+  const ConstraintTerm* term = find_term(e, "half_timestep");
+  ASSERT_NE(term, nullptr);
+  EXPECT_EQ(term->penalty, 0.0);
+  EXPECT_EQ(e.constraint, 0.0);
+}
+
+// Halving the worker's timestep gives the same rollout, bit for bit, as a model compiled
+// at the halved timestep (what the input-motion search simulates), and the next rollout on
+// that worker runs at the task's timestep again.
+TEST(HalfTimestep, ScaledTimestepEqualsACompiledOneAndIsRestored) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  Task halved = task;
+  halved.simulation.timestep = 0.5 * ev.model().get()->opt.timestep;
+  const TaskEvaluator fine_ev(halved);
+  const std::vector<double> values = ev.load_parameters(kLandsApart).values();
+  EvaluationOptions plain;
+  plain.samples_per_phase = 0;
+  auto worker = ev.make_worker();
+  auto fine_worker = fine_ev.make_worker();
+  const Evaluation compiled = fine_ev.evaluate(values, *fine_worker, plain);
+  const Evaluation before = ev.evaluate(values, *worker, plain);
+  EvaluationOptions half = plain;
+  half.timestep_scale = 0.5;
+  const Evaluation scaled = ev.evaluate(values, *worker, half);
+  EXPECT_EQ(scaled.stats.steps, compiled.stats.steps);
+  EXPECT_EQ(scaled.summary.feet_x, compiled.summary.feet_x);
+  EXPECT_EQ(scaled.summary.peak_com_z, compiled.summary.peak_com_z);
+  EXPECT_EQ(worker->model()->opt.timestep, fine_worker->model()->opt.timestep);
+  const Evaluation after = ev.evaluate(values, *worker, plain);
+  EXPECT_EQ(after.stats.steps, before.stats.steps);
+  EXPECT_EQ(after.summary.feet_x, before.summary.feet_x);
+  EXPECT_EQ(worker->model()->opt.timestep, ev.model().get()->opt.timestep);
+}
+
+// The optimizer's outcomes carry the check: the motion that lands apart does not meet
+// the task as a sample of a diversity run.
+TEST(HalfTimestep, TheOptimizersSamplesAreChecked) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const MotionProblem problem(ev, Metric::kMassDistance, m0.normalized(), 1);
+  EXPECT_EQ(problem.evaluate(m0.normalized(), 0)->constraint, 0.0);
+  EXPECT_GT(problem.evaluate(ev.load_parameters(kLandsApart).normalized(), 0)->constraint, 0.0);
+}
+
+// The standing centre of mass is the start pose's, the same for any controller
+// parameters; a body with longer thighs and shins stands taller, so jump_high (peak height
+// above the standing COM) asks it to reach higher.
+TEST(HalfTimestep, StandingComMovesWithTheBody) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  ASSERT_TRUE(task.constraints.peak_height_relative);
+  const TaskEvaluator ev(task);
+  auto worker = ev.make_worker();
+  EvaluationOptions plain;
+  plain.samples_per_phase = 0;
+  const Evaluation m0 = ev.evaluate(ev.load_parameters(task.m0).values(), *worker, plain);
+  const Evaluation other = ev.evaluate(ev.load_parameters(kLandsApart).values(), *worker, plain);
+  EXPECT_EQ(m0.summary.standing_com_z, other.summary.standing_com_z);
+  EXPECT_GT(m0.summary.standing_com_z, 0.8);
+  EXPECT_LT(m0.summary.standing_com_z, 1.0);
+
+  Eigen::VectorXd scales = Eigen::VectorXd::Ones(ev.shapes().size());
+  for (int k = 0; k < ev.shapes().size(); ++k) {
+    const std::string& name = ev.shapes().specs()[static_cast<std::size_t>(k)].name;
+    if (name == "shape.thigh" || name == "shape.shin") scales[k] = 1.3;
+  }
+  const auto scene = ev.shaped_scene(scales);
+  SimWorker tall_worker(scene->model);
+  const Evaluation tall = ev.evaluate(ev.control_values(ev.load_parameters(task.m0)), *scene, tall_worker, plain);
+  EXPECT_GT(tall.summary.standing_com_z, m0.summary.standing_com_z + 0.1);
+  // Whatever the tall body's jump did, its height is judged from where it stood.
+  const double required = task.constraints.peak_height_min + tall.summary.standing_com_z;
+  const ConstraintTerm* term = find_term(tall, "peak_height");
+  ASSERT_NE(term, nullptr);
+  EXPECT_NEAR(term->violation, std::max(0.0, required - tall.summary.peak_com_z), 1e-12);
+}
+
+}  // namespace
+}  // namespace diverse
