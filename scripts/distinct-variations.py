@@ -10,6 +10,12 @@ pairs of M0..MN farther apart than T, and the largest set of motions that are al
 pairwise farther apart than T (the number of distinct motions; exhaustive search, fine for
 N up to about 20); the smallest and mean distance among M1..MN and among M0..MN. Prints
 a Markdown table.
+
+For runs with blends (RUN/blend/summary.json, `diverse blend RUN`), a second table: how
+many blends meet the task, against the path points simulated the same way; which of the
+run's motions the feasible blends are nearest to, and how far (mean and largest); and how
+many feasible blends are farther than F x d0 from every motion of the run (new distinct
+motions).
 """
 import argparse
 import itertools
@@ -73,6 +79,41 @@ def main():
         row.append(f"{min(var):.4g}" if var else "-")
         row.append(f"{sum(var) / len(var):.4g}" if var else "-")
         row.append(f"{sum(every) / len(every):.4g}" if every else "-")
+        print("| " + " | ".join(row) + " |")
+
+    blended = [run for run in args.runs if os.path.exists(os.path.join(run, "blend", "summary.json"))]
+    if not blended:
+        return
+    print()
+    head = ["run", "task", "N", "blends", "meet the task", "path points that meet it",
+            "feasible blends nearest to", "their distance to it: mean, largest"]
+    head += [f"feasible, > {f:g} d0 from every motion" for f in factors]
+    print("| " + " | ".join(head) + " |")
+    print("|" + "---|" * len(head))
+    for run in blended:
+        with open(os.path.join(run, "summary.json")) as f:
+            s = json.load(f)
+        with open(os.path.join(run, "blend", "summary.json")) as f:
+            b = json.load(f)
+        d0 = s.get("nudged_m0_distance", 0.0)
+        labels = b["labels"]
+        feasible = [x for x in b["blends"] if x["feasible"]]
+        k = len(b["blends"])
+        paths = b["paths"]
+        near = {}
+        for x in feasible:
+            if x["nearest"] is not None:
+                near[labels[x["nearest"]]] = near.get(labels[x["nearest"]], 0) + 1
+        dist = [x["distances"][x["nearest"]] for x in feasible if x["nearest"] is not None]
+        row = [os.path.basename(os.path.normpath(run)), b["task"], str(len(labels) - 1), str(k),
+               f"{len(feasible)} ({100.0 * len(feasible) / k:.0f} %)",
+               f"{paths['feasible']} of {paths['points']}" +
+               (f" ({100.0 * paths['feasible'] / paths['points']:.0f} %)" if paths["points"] else ""),
+               ", ".join(f"{l} {c}" for l, c in sorted(near.items(), key=lambda kv: -kv[1])) or "-",
+               f"{sum(dist) / len(dist):.3g}, {max(dist):.3g}" if dist else "-"]
+        for f in factors:
+            row.append(str(sum(1 for x in feasible
+                               if all(v is not None and v > f * d0 for v in x["distances"]))))
         print("| " + " | ".join(row) + " |")
 
 

@@ -197,9 +197,12 @@ try {
       return best;
     };
     const blendTile = page.locator('.tile.blend');
-    const setWeights = async (values) => {
-      for (let i = 0; i < n; ++i) await sliders.nth(i).fill(String(values[i]));
-    };
+    // All sliders at once, then one input event (the page reads every slider on each).
+    const setWeights = (values) => page.evaluate((v) => {
+      const inputs = [...document.querySelectorAll('#blend-weights input[type=range]')];
+      inputs.forEach((s, i) => { s.value = String(v[i]); });
+      inputs[0].dispatchEvent(new Event('input', { bubbles: true }));
+    }, values);
     // Each blend's own weights (as the sliders can hold them) bring up the blend the page
     // should pick, marked as meeting the task or not as its constraint value says.
     let right = 0;
@@ -225,14 +228,21 @@ try {
     const a = expectedNearest(corner(0));
     const other = [...Array(n).keys()].find((i) => expectedNearest(corner(i)) !== a);
     if (other !== undefined) {
+      // Through the sliders themselves, as a user moves them.
+      const fillWeights = async (values) => {
+        for (let i = 0; i < n; ++i) await sliders.nth(i).fill(String(values[i]));
+      };
       await page.locator('#time').fill('600');
-      await setWeights(corner(0));
+      await fillWeights(corner(0));
       await settle();
       await snapshot();
-      await setWeights(corner(other));
+      await fillWeights(corner(other));
       await settle();
       const moved = await snapshot();
       check(moved.changed > 300, 'moving the weights to another corner changes the blend\'s picture', `${moved.changed} pixels changed`);
+      const shownLabel = await page.locator('#blend-result').getAttribute('data-blend');
+      check(shownLabel === blends[expectedNearest(corner(other))].label, 'the sliders pick the blend nearest to their weights',
+        `${shownLabel}, expected ${blends[expectedNearest(corner(other))].label}`);
     }
     await page.locator('#blend-equal').click();
   } else {
