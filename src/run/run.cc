@@ -104,13 +104,23 @@ std::string cluster_setup(const RunSetup& setup) {
   return j.dump();
 }
 
+// How an interrupted run continues: "`diverse resume DIR` continues from ...".
+std::string resume_hint(const fs::path& dir, long long generation) {
+  return "`diverse resume " + dir.string() + "` continues from " +
+         (generation >= 0 ? "the last checkpoint (generation " + std::to_string(generation) + ")"
+                          : std::string("the start (run.json holds the settings)"));
+}
+
 // The line rank 0 prints when mpirun stops it (a worker died, or the job was interrupted).
 std::string stopped_line(const fs::path& dir, long long generation) {
   return "diverse: error: the run was stopped by mpirun (a rank ended, e.g. killed or its "
-         "node lost, or the job was interrupted; mpirun names which); `diverse resume " +
-         dir.string() + "` continues from " +
-         (generation >= 0 ? "the last checkpoint (generation " + std::to_string(generation) + ")"
-                          : std::string("the start (run.json holds the settings)"));
+         "node lost, or the job was interrupted; mpirun names which); " +
+         resume_hint(dir, generation);
+}
+
+// A failure of another rank, with how to continue the run.
+[[noreturn]] void rethrow_resumable(const ClusterError& e, const fs::path& dir, long long generation) {
+  throw ClusterError(std::string(e.what()) + "; " + resume_hint(dir, generation));
 }
 
 // summary.json's timing.messages: this session's traffic between the ranks.
@@ -180,13 +190,17 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
 
   write_checkpoint();
   auto last = std::chrono::steady_clock::now();
-  while (!optimizer.done()) {
-    optimizer.step();
-    const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
-      write_checkpoint();
-      last = now;
+  try {
+    while (!optimizer.done()) {
+      optimizer.step();
+      const auto now = std::chrono::steady_clock::now();
+      if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
+        write_checkpoint();
+        last = now;
+      }
     }
+  } catch (const ClusterError& e) {
+    rethrow_resumable(e, dir, saved_generation);
   }
   write_checkpoint();
   if (progress)
@@ -243,8 +257,15 @@ void start_run(const RunRequest& request) {
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape);
-  const auto batch = cluster_evaluator(request.cluster, setup, problem, pool);
-  DiversityOptimizer optimizer(problem, setup.options, pool, batch.get());
+  std::unique_ptr<BatchEvaluator> batch;
+  std::unique_ptr<DiversityOptimizer> started;
+  try {
+    batch = cluster_evaluator(request.cluster, setup, problem, pool);
+    started = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+  } catch (const ClusterError& e) {
+    rethrow_resumable(e, request.out, -1);
+  }
+  DiversityOptimizer& optimizer = *started;
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
         request.quiet, request.render, request.cluster);
 }
@@ -294,17 +315,27 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   std::unique_ptr<DiversityOptimizer> optimizer;
   if (fs::exists(dir / "checkpoint.json")) {
     const nlohmann::json state = read_run_checkpoint(dir / "checkpoint.json", setup.vary_shape, &wall_before);
-    if (cluster)
-      cluster->set_stop_message(stopped_line(dir, state.value("generation", -1LL)));
-    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
-    optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
+    const long long generation = state.value("generation", -1LL);
+    if (cluster) cluster->set_stop_message(stopped_line(dir, generation));
+    std::unique_ptr<BatchEvaluator> batch;
+    try {
+      batch = cluster_evaluator(cluster, setup, problem, pool);
+      optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
+    } catch (const ClusterError& e) {
+      rethrow_resumable(e, dir, generation);
+    }
     drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
   } else {
     // Stopped between writing run.json and its first checkpoint: run.json holds every
     // setting, so the run starts again from generation 0 (the same run, by determinism).
     if (cluster) cluster->set_stop_message(stopped_line(dir, -1));
-    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
-    optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+    std::unique_ptr<BatchEvaluator> batch;
+    try {
+      batch = cluster_evaluator(cluster, setup, problem, pool);
+      optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+    } catch (const ClusterError& e) {
+      rethrow_resumable(e, dir, -1);
+    }
     drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
   }
 }
