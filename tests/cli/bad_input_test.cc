@@ -118,6 +118,8 @@ TEST(BadInput, OptionsOfEverySubcommand) {
       {"seed-motion jump_high --check-sigmas 0.02 inf", "--check-sigmas: expected a number in [1e-06, 1], got 'inf'"},
       {"bench --seconds 0", "--seconds: expected a number in (0, 3600], got '0'"},
       {"bench --threads 100000", "--threads: expected an integer in [0, 256], got '100000'"},
+      {"bench --rounds 0", "--rounds: expected an integer in [1, 1000], got '0'"},
+      {"bench --batch 0", "--batch: expected an integer in [1, 100000], got '0'"},
       {"character " + dir.string(), dir.string() + ": cannot read the character file (it is a directory)"},
       {"render " + (dir / "nowhere").string(), "nowhere: no such directory"},
       {"render " + dir.string() + " --fps 45", "--fps: expected 30 or 60, got 45"},
