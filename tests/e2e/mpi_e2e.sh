@@ -5,7 +5,7 @@
 #   mpi_e2e.sh DIVERSE_BINARY SOURCE_DIR MPIRUN
 #
 # 1. Two ranks give the summary.json of one process (the "timing" object aside), and
-#    "timing" says 2 ranks.
+#    "timing" says 2 ranks; so does the simultaneous strategy.
 # 2. A run of 2 ranks killed (rank 0, SIGKILL) after its checkpoint of generation 2 and
 #    resumed by one process, and a run of one process killed the same way and resumed by 2
 #    ranks, both end with the uninterrupted run's summary.
@@ -73,6 +73,15 @@ args=(--n 2 --popsize 8 --sigma0 0.03 --seed 3 --threads 1 --quiet --no-render)
 [ "$(jq '.timing.ranks' "$work/two/summary.json")" == 2 ] || fail "2 ranks: timing.ranks is not 2"
 [ "$(jq '.timing.ranks' "$work/one/summary.json")" == 1 ] || fail "one process: timing.ranks is not 1"
 echo "ok: 2 ranks = 1 process"
+
+# 1b. The simultaneous strategy (one batch of N x lambda per generation) under 2 ranks.
+sim=("${args[@]}" --generations 2 --strategy simultaneous)
+"$diverse" run "$task" "${sim[@]}" --out "$work/sim1" || fail "diverse run --strategy simultaneous (one process)"
+"${mpi[@]}" "$diverse" run "$task" "${sim[@]}" --out "$work/sim2" >"$work/sim2.txt" 2>&1 ||
+  { cat "$work/sim2.txt"; fail "mpirun -n 2 diverse run --strategy simultaneous"; }
+[ "$(summary "$work/sim1")" == "$(summary "$work/sim2")" ] ||
+  { diff <(summary "$work/sim1") <(summary "$work/sim2") | head -20; fail "simultaneous, 2 ranks: summary.json differs from one process's"; }
+echo "ok: simultaneous, 2 ranks = 1 process"
 
 # The uninterrupted run the interrupted ones must end with (6 generations, a checkpoint
 # after every generation).
