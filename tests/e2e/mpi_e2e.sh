@@ -137,10 +137,14 @@ mpid=$!
 wait_generation "$work/d" 2 "$mpid" || { cat "$work/d.txt"; fail "4: the run ended before generation 2"; }
 worker="$(rank_pid "$mpid" 1)" || fail "4: no rank 1 to stop"
 kill -STOP "$worker"
-for _ in $(seq 1 300); do kill -0 "$mpid" 2>/dev/null || break; sleep 0.1; done
+# Generous: on a loaded machine the niced ranks may wait long for a core.
+stopped_at=$SECONDS
+while kill -0 "$mpid" 2>/dev/null && [ $((SECONDS - stopped_at)) -lt 120 ]; do sleep 0.2; done
 if kill -0 "$mpid" 2>/dev/null; then
+  cat "$work/d.txt"
+  ps -o pid,stat,etime,args --ppid "$mpid" || true
   kill -CONT "$worker"; kill -9 "$worker" "$mpid"
-  fail "4: mpirun still runs 30 s after a worker was stopped (rank timeout 2 s)"
+  fail "4: mpirun still runs 120 s after a worker was stopped (rank timeout 2 s)"
 fi
 wait "$mpid"
 status=$?
