@@ -170,7 +170,16 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
     throw UserError(run_file.string() + ": task_file: " + task_file + " is missing;" + what);
   if (read_file(task_file) != run.run.value("task_text", std::string()))
     throw UserError(run_file.string() + ": task_file: " + task_file + " changed since the run;" + what);
-  const TaskEvaluator evaluator(load_task(task_file));
+  // The run's strength model and bounds (absent in older runs: 1 and none), so that the
+  // path points are simulated and judged as the run judged its samples.
+  Task task = load_task(task_file);
+  const nlohmann::json strength = run.run.value("strength", nlohmann::json(1.0));
+  if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
+    throw_field_error(run_file.string(), "strength", "a number in [0.1, 10]");
+  task.strength = strength.get<double>();
+  const MotionBounds bounds =
+      motion_bounds_from_json(run.run.value("bounds", nlohmann::json()), run_file.string());
+  const TaskEvaluator evaluator(std::move(task));
   const DistanceSpec distance =
       parse_distance(run.metric, run.run.value("shape_weight", kDefaultShapeWeight),
                      (run.dir / "summary.json").string() + ": metric", run_file.string() + ": shape_weight");
@@ -182,7 +191,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   const ParameterSet m0 = motion_parameters(like, run.motions[0].file);
 
   const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
-  const MotionProblem problem(evaluator, distance, m0.normalized(), threads, vary_shape);
+  const MotionProblem problem(evaluator, distance, m0.normalized(), threads, vary_shape, bounds);
   ThreadPool pool(threads);
 
   // Which points of each path are simulated to measure distances: all, or evenly spaced.
@@ -476,7 +485,7 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                          {"metric", run.metric},
                          {"fps", options.fps}};
   for (const char* key : {"N", "K", "strategy", "seed", "generations", "evaluations", "D",
-                          "all_satisfied", "stop"})
+                          "all_satisfied", "stop", "strength", "bounds"})
     if (s.contains(key)) data["run"][key] = s[key];
 
   nlohmann::json models = nlohmann::json::array();
@@ -505,6 +514,11 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                        {"status", m.status()},
                        {"duration", m.duration()},
                        {"frames", body_frames_json(m.model->get(), sampled[i])}});
+    // Effort and distance from M0, and whether the motion keeps the run's bounds.
+    if (s.contains("motions") && s["motions"].is_array() && i < s["motions"].size() &&
+        s["motions"][i].is_object())
+      for (const char* key : {"effort", "effort_ratio", "positive_work", "distance_to_m0", "within_bounds"})
+        if (s["motions"][i].contains(key)) motions.back()[key] = s["motions"][i][key];
   }
   nlohmann::json strips = nlohmann::json::array();
   // [x0, x1] along the track, or [x0, x1, y, radius] for a disc centred between x0 and x1.

@@ -36,9 +36,9 @@ else
   work="$(mktemp -d)"
   trap 'rm -rf "$work"' EXIT
 fi
-# Short but real: 2 variations, 3 generations of 8 samples.
+# Short but real: 2 variations, 3 generations of 8 samples, within bounds the page shows.
 "$diverse" run "$src/tasks/jump_high.toml" --n 2 --generations 3 --popsize 8 --sigma0 0.03 --seed 5 \
-  --quiet --no-render --out "$work/run"
+  --effort-bound 3 --max-distance 1000 --quiet --no-render --out "$work/run"
 "$diverse" gallery "$work/run"
 "$diverse" export "$work/run" --bvh --gltf
 CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/run"
