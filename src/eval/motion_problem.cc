@@ -37,16 +37,16 @@ nlohmann::json to_json(const MotionBounds& bounds) {
 MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string& where) {
   MotionBounds bounds;
   if (j.is_null()) return bounds;
-  if (!j.is_object()) throw_field_error(where, "bounds", "an object");
+  if (!j.is_object()) throw_field_error(where, "bounds", "expected an object");
   for (const auto& item : j.items())
     if (item.key() != "effort" && item.key() != "distance")
-      throw_field_error(where, "bounds." + item.key(), "only the keys effort and distance");
+      throw_field_error(where, "bounds." + item.key(), "expected only the keys effort and distance");
   auto number = [&](const char* key, bool open_low, double lo, double hi, const char* range) {
     if (!j.contains(key)) return 0.0;
     const nlohmann::json& v = j.at(key);
     const double x = v.is_number() ? v.get<double>() : std::nan("");
     if (!((open_low ? x > lo : x >= lo) && x <= hi))
-      throw_field_error(where, std::string("bounds.") + key, std::string("a number in ") + range);
+      throw_field_error(where, std::string("bounds.") + key, std::string("expected a number in ") + range);
     return x;
   };
   bounds.effort = number("effort", false, kMinEffortBound, kMaxEffortBound, "[1, 1e6]");

@@ -175,7 +175,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   Task task = load_task(task_file);
   const nlohmann::json strength = run.run.value("strength", nlohmann::json(1.0));
   if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
-    throw_field_error(run_file.string(), "strength", "a number in [0.1, 10]");
+    throw_field_error(run_file.string(), "strength", "expected a number in [0.1, 10]");
   task.strength = strength.get<double>();
   const MotionBounds bounds =
       motion_bounds_from_json(run.run.value("bounds", nlohmann::json()), run_file.string());

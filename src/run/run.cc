@@ -308,7 +308,7 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
     // Runs from before strength and bounds existed have neither: strength 1, no bounds.
     const nlohmann::json& strength = run.contains("strength") ? run["strength"] : nlohmann::json(1.0);
     if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
-      throw_field_error(where, "strength", "a number in [0.1, 10]");
+      throw_field_error(where, "strength", "expected a number in [0.1, 10]");
     setup = make_setup(task_file, run.at("metric").get<std::string>(),
                        run.value("shape_weight", kDefaultShapeWeight), read_vary_shape(run, where),
                        options, strength.get<double>(),
