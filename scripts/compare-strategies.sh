@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Paper section 9: round-robin against progressive addition on the backflip, N = 4,
 # five seeds each; prints Dmin, mean and Dmax of both beside the paper's figures.
-#   scripts/compare-strategies.sh [GENERATIONS] [OUT] [VARIANT]
+#   scripts/compare-strategies.sh [GENERATIONS] [OUT] [VARIANT] [STRATEGIES]
+# STRATEGIES (default "round-robin progressive") names the strategies to compare, e.g.
+# "round-robin simultaneous" (docs/results.md); every one runs the same five seeds.
 # VARIANT is `ours` (default: violating samples rank below feasible ones, a variation
 # stands at its best sample) or `paper` (eq. 1 literally: --constraints penalty --point
 # mean, as the paper prints it).
@@ -15,6 +17,7 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 generations="${1:-500}"
 out="${2:-$here/runs/section9}"
 variant="${3:-ours}"
+strategies="${4:-round-robin progressive}"
 diverse="${DIVERSE:-$here/build/diverse}"
 case "$variant" in
   ours) constraints=dominant point=best-sample ;;
@@ -34,7 +37,7 @@ same_run() {
 }
 
 runs=()
-for strategy in round-robin progressive; do
+for strategy in $strategies; do
   for seed in 1 2 3 4 5; do
     dir="$out/$strategy-$seed"
     runs+=("$dir")
@@ -53,7 +56,7 @@ done
 "$diverse" report "${runs[@]}" | tee "$out/table.md"
 echo
 echo "paper: progressive Dmin 41.8, mean 54.4, Dmax 64.1; round-robin 71.2 / 83.5 / 103.7"
-for strategy in round-robin progressive; do
+for strategy in $strategies; do
   awk -F'|' -v s="$strategy" '$5 ~ s { d = $9 + 0; n++; sum += d; if (n == 1 || d < lo) lo = d; if (n == 1 || d > hi) hi = d }
     END { printf "ours:  %-12s Dmin %.4g, mean %.4g, Dmax %.4g (%d runs)\n", s, lo, sum / n, hi, n }' "$out/table.md"
 done

@@ -1,16 +1,25 @@
 #!/usr/bin/env python3
-"""Predicted wall time per generation of a round-robin run on R ranks (docs/scaling.md).
+"""Predicted wall time per generation and utilization of R ranks (docs/scaling.md).
 
-    scripts/scaling-model.py RUN_DIR [--popsize 16] [--n 4] [--threads 1]
+    scripts/scaling-model.py RUN_DIR... [--strategy round-robin|simultaneous|both]
+                             [--popsize 16] [--n 4] [--threads 1] [--overhead-us US]
 
-Reads RUN_DIR/summary.json of a run made with `mpirun -n R diverse run` (its
-timing.messages: the remote rollouts' time quantiles and the message overhead per
-rollout, both measured) and models a generation: N batches of lambda rollouts, each batch
-handed out dynamically to R x threads slots (the next free slot takes the next sample),
-every rollout that rank 0 does not compute itself costing the measured overhead on top.
-Rollout times are drawn from the measured quantiles (piecewise linear between p10, p50,
-p90 and max, flat below p10). Prints ranks, predicted seconds per generation, and the
-speed-up over one slot. Everything printed is derived; only the inputs are measured.
+Reads the rollout times a run measured (RUN_DIR/summary.json, "timing"):
+  timing.rollouts.cpu_ms.deciles  a single-process run: every rollout's CPU time,
+                                  p0, p10, ..., p100 (load-independent);
+  timing.messages                 a run made with `mpirun -n R`: the remote rollouts'
+                                  time quantiles and the message overhead per rollout.
+Several RUN_DIRs: their deciles are averaged point by point.
+
+Models a generation: round-robin is N batches of lambda rollouts (one variation after
+another), simultaneous one batch of N x lambda. Each batch is handed out dynamically to
+R x threads slots (the next free slot takes the next sample, as src/distribute does) and
+lasts until its last rollout ends; every rollout that rank 0 does not compute itself
+costs the overhead on top (measured under mpirun, or --overhead-us). Rollout times are
+drawn from the measured quantiles (piecewise linear between them). Prints, per R, the
+predicted ms per generation, the speed-up over one slot and the utilization: the
+rollouts' own time over (slots x wall time), i.e. the share of the R workers' time spent
+computing. Everything printed is derived; only the inputs are measured.
 """
 import argparse
 import json
@@ -18,8 +27,8 @@ import random
 import sys
 
 
-def sampler(q):
-    points = [(0.0, q["p10"]), (0.1, q["p10"]), (0.5, q["p50"]), (0.9, q["p90"]), (1.0, q["max"])]
+def sampler(points):
+    """points: [(u, t)] increasing in u from 0 to 1."""
 
     def draw(rng):
         u = rng.random()
@@ -31,6 +40,27 @@ def sampler(q):
     return draw
 
 
+def read_times(runs):
+    """Quantile points and the overhead per remote rollout (ms) from the runs."""
+    deciles, overheads, quantiles = [], [], None
+    for run in runs:
+        timing = json.load(open(f"{run}/summary.json"))["timing"]
+        if "rollouts" in timing:
+            deciles.append(timing["rollouts"]["cpu_ms"]["deciles"])
+        elif "messages" in timing:
+            m = timing["messages"]
+            q = m["remote_rollout_ms"]
+            quantiles = [(0.0, q["p10"]), (0.1, q["p10"]), (0.5, q["p50"]), (0.9, q["p90"]), (1.0, q["max"])]
+            overheads.append(m["overhead_us_per_evaluation"] / 1000.0)
+        else:
+            sys.exit(f"{run}: summary.json has no timing.rollouts or timing.messages")
+    if deciles:
+        mean = [sum(d[k] for d in deciles) / len(deciles) for k in range(11)]
+        quantiles = [(k / 10.0, mean[k]) for k in range(11)]
+    overhead = sum(overheads) / len(overheads) if overheads else None
+    return quantiles, overhead
+
+
 def batch_time(times, slots, local_slots, overhead):
     free = [0.0] * slots  # slot s < local_slots is rank 0's own thread (no messages)
     for t in times:
@@ -39,34 +69,51 @@ def batch_time(times, slots, local_slots, overhead):
     return max(free)
 
 
+def model(draw, strategy, n, popsize, threads, overhead, trials, ranks_list, rng):
+    rows = []
+    base = None
+    for ranks in ranks_list:
+        slots = ranks * threads
+        wall = work = 0.0
+        for _ in range(trials):
+            batches = [popsize] * n if strategy == "round-robin" else [n * popsize]
+            for size in batches:
+                times = [draw(rng) for _ in range(size)]
+                work += sum(times)
+                wall += batch_time(times, slots, threads, overhead)
+        per_gen = wall / trials
+        base = base or per_gen
+        rows.append((ranks, per_gen, base / per_gen, work / (slots * wall)))
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("run")
+    ap.add_argument("runs", nargs="+")
+    ap.add_argument("--strategy", default="both", choices=["round-robin", "simultaneous", "both"])
     ap.add_argument("--popsize", type=int, default=16)
     ap.add_argument("--n", type=int, default=4)
     ap.add_argument("--threads", type=int, default=1, help="threads per rank")
+    ap.add_argument("--overhead-us", type=float, default=None,
+                    help="message cost per remote rollout (default: the runs' measured one, else 0)")
+    ap.add_argument("--ranks", default="1,2,4,8,16,32,64")
     ap.add_argument("--trials", type=int, default=400)
     a = ap.parse_args()
-    timing = json.load(open(f"{a.run}/summary.json"))["timing"]
-    if "messages" not in timing:
-        sys.exit(f"{a.run}: summary.json has no timing.messages (run it with mpirun -n 2 or more)")
-    m = timing["messages"]
-    draw = sampler(m["remote_rollout_ms"])
-    overhead = m["overhead_us_per_evaluation"] / 1000.0
-    rng = random.Random(1)
-    print(f"# lambda {a.popsize}, N {a.n}, {a.threads} thread(s) per rank; rollout p50 "
-          f"{m['remote_rollout_ms']['p50']:.2f} ms, overhead {overhead * 1000:.0f} us per remote rollout")
-    print("ranks  ms/generation  speed-up")
-    base = None
-    for ranks in (1, 2, 4, 8, 16, 32, 64):
-        slots = ranks * a.threads
-        total = 0.0
-        for _ in range(a.trials):
-            for _ in range(a.n):
-                total += batch_time([draw(rng) for _ in range(a.popsize)], slots, a.threads, overhead)
-        per_gen = total / a.trials
-        base = base or per_gen
-        print(f"{ranks:5d}  {per_gen:13.1f}  {base / per_gen:8.2f}")
+    quantiles, measured_overhead = read_times(a.runs)
+    overhead = a.overhead_us / 1000.0 if a.overhead_us is not None else (measured_overhead or 0.0)
+    draw = sampler(quantiles)
+    ranks_list = [int(r) for r in a.ranks.split(",")]
+    median = next(t for u, t in quantiles if u >= 0.5)
+    print(f"# lambda {a.popsize}, N {a.n}, {a.threads} thread(s) per rank; rollout p50 {median:.2f} ms, "
+          f"p90 {next(t for u, t in quantiles if u >= 0.9):.2f} ms, max {quantiles[-1][1]:.2f} ms; "
+          f"overhead {overhead * 1000:.0f} us per remote rollout")
+    strategies = ["round-robin", "simultaneous"] if a.strategy == "both" else [a.strategy]
+    for strategy in strategies:
+        rng = random.Random(1)
+        print(f"{strategy}: ranks  ms/generation  speed-up  utilization")
+        for ranks, per_gen, speedup, util in model(draw, strategy, a.n, a.popsize, a.threads, overhead,
+                                                   a.trials, ranks_list, rng):
+            print(f"{'':{len(strategy)}}  {ranks:5d}  {per_gen:13.1f}  {speedup:8.2f}  {100 * util:10.1f} %")
 
 
 if __name__ == "__main__":

@@ -5,6 +5,12 @@
 // joints and limits come from the saved model's actuators, physics/drive.h). Exits 1 if
 // the qpos difference exceeds 1e-6 or a net torque exceeds its limit by more than 1 %
 // (SPEC section 8).
+//
+// A walk (a motion whose summary has walk steps) is also audited from geometry alone
+// (task/walk_audit.h): steps counted from foot contacts, every step's length in the
+// heading frame, pelvis and torso tilt, falls and the turn, against the task's [walk]
+// rules; one line per step and exit 1 on a broken rule. The task file is --task, else the
+// run's (RUN/run.json beside motions/), else tasks/<task>.toml.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -13,10 +19,13 @@
 
 #include "command.h"
 #include "options.h"
+#include "core/error.h"
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/drive.h"
 #include "physics/model.h"
+#include "task/task.h"
+#include "task/walk_audit.h"
 
 namespace diverse::cli {
 namespace {
@@ -41,12 +50,66 @@ NetTorqueCheck check_motion_torques(const std::string& path, std::string* worst_
   return check;
 }
 
+// The task file of a walk motion: `given`, else the run's, else tasks/<name>.toml.
+std::string walk_task_file(const std::string& motion_path, const nlohmann::json& motion, const std::string& given) {
+  if (!given.empty()) return given;
+  const std::filesystem::path run_json = std::filesystem::path(motion_path).parent_path().parent_path() / "run.json";
+  if (std::filesystem::exists(run_json)) {
+    const nlohmann::json run = read_json(run_json);
+    if (run.contains("task_file") && run["task_file"].is_string()) {
+      const std::string file = run["task_file"].get<std::string>();
+      if (std::filesystem::exists(file)) return file;
+    }
+  }
+  const std::string name = motion.value("task", std::string());
+  try {
+    return resolve_task_path(name);
+  } catch (const UserError&) {
+    throw UserError(motion_path + ": task: the walk's task file '" + name +
+                    "' was not found; give it with --task FILE");
+  }
+}
+
+// Prints the audit of a walk motion; returns false if it breaks a rule of its task.
+bool audit_walk_motion(const std::string& path, const std::string& task_option) {
+  const nlohmann::json motion = read_json(path);
+  if (!motion.contains("summary") || !motion["summary"].contains("walk_steps")) return true;
+  const Task task = load_task(walk_task_file(path, motion, task_option));
+  if (!task.walk.enabled) throw UserError(task.file + ": expected a walk task (a [walk] table) for the walk " + path);
+  std::filesystem::path model_path;
+  const StepRecorder record = read_replay_record(motion, path, &model_path);
+  const auto model = SharedModel::from_file(model_path.string());
+  const Character body = bind_character(task.character_spec, model->get(), model_path.string());
+  const WalkAudit a = audit_walk(model->get(), record, body, task.walk);
+  std::printf("walk audit (%s, from foot contacts): %zu steps, %d re-landings of a foot\n", task.name.c_str(),
+              a.steps.size(), a.relandings);
+  std::printf("  step  leg    time   forward   lateral   tilt  heading\n");
+  for (size_t k = 0; k < a.steps.size(); ++k) {
+    const WalkAudit::Step& s = a.steps[k];
+    std::printf("  %4zu  %s  %6.3f  %7.3f m %7.3f m %5.1f°  %6.1f°%s\n", k + 1, s.leg == 0 ? "left " : "right",
+                s.time, s.forward, s.lateral, s.tilt * 180 / M_PI, s.heading * 180 / M_PI,
+                static_cast<int>(k) < task.walk.settle_steps ? "  (settling)" : "");
+  }
+  std::printf("  evaluated steps: forward %.3f to %.3f m, lateral %.3f to %.3f m, tilt at most %.1f°, turn %.1f°\n",
+              a.forward_min, a.forward_max, a.lateral_min, a.lateral_max, a.max_tilt * 180 / M_PI,
+              a.turn * 180 / M_PI);
+  if (a.violations.empty()) {
+    std::printf("  meets the walk rules of %s\n", task.name.c_str());
+    return true;
+  }
+  for (const std::string& v : a.violations) std::fprintf(stderr, "diverse: walk audit: %s\n", v.c_str());
+  return false;
+}
+
 void install(CLI::App& app) {
   auto path = std::make_shared<std::string>();
+  auto task = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "replay", "Replay a motion record in plain MuJoCo, compare qpos and check net joint torques");
   cmd->add_option("motion", *path, "motion.json written by simulate or run")->required();
-  cmd->callback([path] {
+  cmd->add_option("--task", *task,
+                  "Task file whose [walk] rules a walk is audited against (default: the run's, else tasks/<task>.toml)");
+  cmd->callback([path, task] {
     int steps = 0;
     const double diff = replay_motion_file(*path, &steps);
     std::printf("replayed %d steps, max |qpos difference| = %.3g\n", steps, diff);
@@ -73,6 +136,7 @@ void install(CLI::App& app) {
                    100 * kTorqueTolerance);
       failed = true;
     }
+    if (!audit_walk_motion(*path, *task)) failed = true;
     if (failed) std::exit(1);
   });
 }

@@ -24,6 +24,16 @@ namespace {
 
 constexpr const char* kDefaultTask = "jump_high";
 constexpr double kMaxCheckpointSeconds = 86400;
+constexpr double kMaxRankTimeoutSeconds = 86400;
+
+// --rank-timeout of run and resume (distribute/cluster.h).
+void add_rank_timeout(CLI::App* cmd, double* seconds) {
+  cmd->add_option("--rank-timeout", *seconds,
+                  "Under mpirun: seconds rank 0 waits for a word from a worker rank holding samples "
+                  "before it ends the run naming that rank")
+      ->capture_default_str()
+      ->check(number_in(kMinRankTimeoutSeconds, kMaxRankTimeoutSeconds));
+}
 
 struct RunArgs {
   std::string task = kDefaultTask;
@@ -50,6 +60,7 @@ struct RunArgs {
   double strength = 1.0;
   double effort_bound = 0.0;  // 0 = none
   double max_distance = 0.0;  // 0 = none
+  double rank_timeout = kDefaultRankTimeoutSeconds;
 };
 
 void install_run(CLI::App& app) {
@@ -80,7 +91,7 @@ void install_run(CLI::App& app) {
   cmd->add_option("--generations", args->generations, "Generation limit")
       ->capture_default_str()
       ->check(integer_in(1, kMaxGenerations));
-  cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
+  cmd->add_option("--strategy", args->strategy, "round-robin, progressive, joint or simultaneous")
       ->capture_default_str();
   cmd->add_option("--constraints", args->constraints,
                   "dominant (a violating sample ranks below every feasible one) or penalty "
@@ -129,6 +140,7 @@ void install_run(CLI::App& app) {
                   "Wall seconds between checkpoints (0 = every generation)")
       ->capture_default_str()
       ->check(number_in(0, kMaxCheckpointSeconds));
+  add_rank_timeout(cmd, &args->rank_timeout);
   cmd->callback([args] {
     const RunArgs& a = *args;
     // Ranges are checked by the options' validators (options.h); n = 0 and sigma0 = 0
@@ -169,6 +181,7 @@ void install_run(CLI::App& app) {
     // Under mpirun with several ranks, rank 0 runs and the others evaluate its samples.
     const auto cluster = Cluster::join();
     if (cluster && cluster->rank() > 0) return serve_run(*cluster, a.threads);
+    if (cluster) cluster->set_rank_timeout(a.rank_timeout);
     request.cluster = cluster.get();
     start_run(request);
   });
@@ -180,6 +193,7 @@ void install_resume(CLI::App& app) {
   auto quiet = std::make_shared<bool>(false);
   auto checkpoint_seconds = std::make_shared<double>(5.0);
   auto no_render = std::make_shared<bool>(false);
+  auto rank_timeout = std::make_shared<double>(kDefaultRankTimeoutSeconds);
   CLI::App* cmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
   cmd->add_option("dir", *dir, "Run directory")->required();
   cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")
@@ -191,9 +205,11 @@ void install_resume(CLI::App& app) {
                   "Wall seconds between checkpoints (0 = every generation)")
       ->capture_default_str()
       ->check(number_in(0, kMaxCheckpointSeconds));
-  cmd->callback([dir, threads, quiet, checkpoint_seconds, no_render] {
+  add_rank_timeout(cmd, rank_timeout.get());
+  cmd->callback([dir, threads, quiet, checkpoint_seconds, no_render, rank_timeout] {
     const auto cluster = Cluster::join();
     if (cluster && cluster->rank() > 0) return serve_run(*cluster, *threads);
+    if (cluster) cluster->set_rank_timeout(*rank_timeout);
     resume_run(*dir, *threads, *quiet, *checkpoint_seconds, !*no_render, cluster.get());
   });
 }

@@ -219,7 +219,7 @@ void add_toy(CLI::App& app) {
   cmd->add_option("--generations", args->generations, "generation limit")
       ->capture_default_str()
       ->check(integer_in(1, kMaxGenerations));
-  cmd->add_option("--strategy", args->strategy, "round-robin, progressive or joint")
+  cmd->add_option("--strategy", args->strategy, "round-robin, progressive, joint or simultaneous")
       ->capture_default_str();
   cmd->add_option("--constraints", args->constraints,
                   "dominant (a violating sample ranks below every feasible one) or penalty "

@@ -18,6 +18,8 @@
 //      result  w -> 0   [batch u64][slot u64][ns u64][outcome bytes]  MotionProblem::encode,
 //                       ns: the worker's time in evaluate()
 //      fail    w -> 0   [batch u64][slot u64][0 u64][one-line reason]
+//      beat    w -> 0   [0 u64][0 u64][0 u64]  a worker holding tasks that has sent nothing
+//                       for 0.5 s (a long rollout): it is alive
 //      Work is handed out dynamically: each worker holds at most as many tasks as it has
 //      threads, gets the next free slot when a result comes back, and rank 0's own thread
 //      pool takes slots from the same counter. A batch ends when every slot is filled.
@@ -27,11 +29,17 @@
 // an idle rank leaves its core to the ranks that compute.
 //
 // Failures. A worker whose evaluation throws sends `fail`; rank 0 ends the run with a
-// ClusterError. A worker that dies (killed, out of memory, its node lost) makes mpirun
-// stop every rank: rank 0 then prints one line naming that, the run directory and the
+// ClusterError. A worker that holds tasks (or owes its setup answer) and says nothing
+// for the rank timeout (set_rank_timeout, `--rank-timeout`, 30 s by default) is lost: it
+// was stopped, hangs, or its node or the network went away without mpirun noticing.
+// Rank 0 ends the run with a ClusterError naming the rank, leaves without MPI_Finalize
+// (which would wait for the lost rank), and mpirun, seeing rank 0 exit 2, stops the
+// others and exits 2 too. A worker that dies (killed, out of memory) makes mpirun stop
+// every rank at once: rank 0 then prints one line naming that, the run directory and the
 // last checkpoint's generation (`diverse resume DIR` continues from it), and exits 2;
-// mpirun itself reports which rank died and exits with that rank's status. The
-// checkpoint is written atomically, so it is always whole.
+// mpirun itself reports which rank died and exits with that rank's status (137 for
+// SIGKILL: Open MPI 4 decides that, not diverse). The checkpoint is written atomically,
+// so it is always whole.
 //
 // Without MPI (a build configured where Open MPI is not installed), join() returns
 // nullptr for a process started on its own and throws UserError for one that mpirun
@@ -60,6 +68,10 @@ class ClusterError : public UserError {
 // True when this build was configured with MPI.
 bool cluster_support();
 
+// How long rank 0 waits for a word from a worker that holds tasks (see Failures above).
+constexpr double kDefaultRankTimeoutSeconds = 30.0;
+constexpr double kMinRankTimeoutSeconds = 2.0;  // workers beat every 0.5 s
+
 class Cluster {
  public:
   using Decode = std::function<std::shared_ptr<const Outcome>(const std::string& bytes)>;
@@ -75,6 +87,9 @@ class Cluster {
 
   int rank() const;
   int size() const;
+  // Rank 0: seconds without a word from a worker holding tasks before the run ends with a
+  // ClusterError naming it (>= kMinRankTimeoutSeconds; std::invalid_argument otherwise).
+  void set_rank_timeout(double seconds);
   // Threads for --threads 0: this node's hardware threads shared among its ranks.
   int default_threads() const;
 

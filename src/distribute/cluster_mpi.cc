@@ -23,7 +23,10 @@
 namespace diverse {
 namespace {
 
-enum Tag : int { kSetup = 1, kReady = 2, kRefuse = 3, kTask = 4, kResult = 5, kFail = 6, kStop = 7 };
+enum Tag : int { kSetup = 1, kReady = 2, kRefuse = 3, kTask = 4, kResult = 5, kFail = 6, kStop = 7, kBeat = 8 };
+
+// A worker holding tasks sends `beat` whenever it has sent nothing for this long.
+constexpr double kBeatSeconds = 0.5;
 
 // Polling backoff: short sleeps while messages are frequent, longer ones when idle.
 class Backoff {
@@ -56,8 +59,10 @@ void send(const std::string& bytes, int to, int tag) {
 }
 
 // Waits (polling) for a message from `from` (MPI_ANY_SOURCE allowed) and receives it.
-std::string receive(int from, int* tag, int* source) {
+// With `timeout_seconds` > 0, returns false if none came in that time.
+bool receive(int from, int* tag, int* source, std::string* out, double timeout_seconds = 0) {
   Backoff backoff;
+  const auto start = std::chrono::steady_clock::now();
   for (;;) {
     int flag = 0;
     MPI_Status status;
@@ -71,8 +76,12 @@ std::string receive(int from, int* tag, int* source) {
             "receive");
       *tag = status.MPI_TAG;
       if (source) *source = status.MPI_SOURCE;
-      return bytes;
+      *out = std::move(bytes);
+      return true;
     }
+    if (timeout_seconds > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout_seconds)
+      return false;
     backoff.sleep();
   }
 }
@@ -156,9 +165,22 @@ struct Cluster::Impl {
   std::vector<std::string> hosts;       // rank 0: each worker's host
   std::uint64_t batches = 0;
   Traffic traffic;
+  double rank_timeout = kDefaultRankTimeoutSeconds;  // rank 0: see set_rank_timeout
+  bool lost = false;                    // rank 0: a worker stopped answering (no MPI_Finalize)
 
   std::string who(int r) const {
     return "rank " + std::to_string(r) + " (" + (r < static_cast<int>(hosts.size()) && !hosts[static_cast<std::size_t>(r)].empty() ? hosts[static_cast<std::size_t>(r)] : std::string("?")) + ")";
+  }
+
+  // Rank 0 gives up on worker r: it has held work (or owed its setup answer) without a
+  // word for longer than rank_timeout.
+  ClusterError lost_rank(int r, const char* waiting_for) {
+    lost = true;
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%g", rank_timeout);
+    return ClusterError(who(r) + " has not answered for " + seconds + " s while " + waiting_for +
+                        " (it was stopped, hangs, or its node or network is lost; --rank-timeout "
+                        "sets how long to wait)");
   }
 };
 
@@ -214,6 +236,8 @@ class ClusterEvaluator : public BatchEvaluator {
     std::vector<int> held(static_cast<std::size_t>(impl_.size), 0);
     using Clock = std::chrono::steady_clock;
     std::vector<Clock::time_point> sent(n);
+    // When each worker last said anything (or, if it was idle, got its first task).
+    std::vector<Clock::time_point> heard(static_cast<std::size_t>(impl_.size), Clock::now());
     int in_flight = 0;
     Backoff backoff;
     std::string bytes;
@@ -223,6 +247,7 @@ class ClusterEvaluator : public BatchEvaluator {
         while (held[static_cast<std::size_t>(w)] < impl_.threads[static_cast<std::size_t>(w)]) {
           const std::size_t k = next.fetch_add(1);
           if (k >= n) break;
+          if (held[static_cast<std::size_t>(w)] == 0) heard[static_cast<std::size_t>(w)] = Clock::now();
           const std::string task = with_header(Header{batch, k, 0}, reinterpret_cast<const char*>(xs[k].data()),
                                                static_cast<std::size_t>(xs[k].size()) * sizeof(double));
           sent[k] = Clock::now();
@@ -241,6 +266,8 @@ class ClusterEvaluator : public BatchEvaluator {
       int tag = 0, source = 0;
       if (in_flight > 0 && try_receive(MPI_ANY_SOURCE, &bytes, &tag, &source)) {
         backoff.reset();
+        heard[static_cast<std::size_t>(source)] = Clock::now();
+        if (tag == kBeat) continue;
         const Header h = header_of(bytes);
         if (tag == kFail)
           throw ClusterError(impl_.who(source) + ": " + bytes.substr(sizeof(Header)));
@@ -259,6 +286,14 @@ class ClusterEvaluator : public BatchEvaluator {
         --held[static_cast<std::size_t>(source)];
         --in_flight;
         continue;
+      }
+      if (in_flight > 0) {
+        const auto now = Clock::now();
+        for (int w = 1; w < impl_.size; ++w) {
+          if (held[static_cast<std::size_t>(w)] > 0 &&
+              std::chrono::duration<double>(now - heard[static_cast<std::size_t>(w)]).count() > impl_.rank_timeout)
+            throw impl_.lost_rank(w, "evaluating samples");
+        }
       }
       backoff.sleep();
     }
@@ -307,6 +342,13 @@ std::unique_ptr<Cluster> Cluster::join() {
 }
 
 Cluster::~Cluster() {
+  if (impl_->lost) {
+    // MPI_Finalize waits for every rank, the lost one too: leave without it. Rank 0's
+    // nonzero exit makes mpirun stop the other ranks.
+    signal(SIGTERM, SIG_DFL);
+    signal(SIGINT, SIG_DFL);
+    return;
+  }
   if (impl_->rank == 0 && !impl_->stopped) {
     for (int w = 1; w < impl_->size; ++w)
       MPI_Send(nullptr, 0, MPI_BYTE, w, kStop, MPI_COMM_WORLD);
@@ -320,6 +362,12 @@ Cluster::~Cluster() {
 }
 
 int Cluster::rank() const { return impl_->rank; }
+
+void Cluster::set_rank_timeout(double seconds) {
+  if (!(seconds >= kMinRankTimeoutSeconds))
+    throw std::invalid_argument("Cluster::set_rank_timeout: expected seconds >= the minimum");
+  impl_->rank_timeout = seconds;
+}
 int Cluster::size() const { return impl_->size; }
 
 int Cluster::default_threads() const {
@@ -331,7 +379,11 @@ void Cluster::start_workers(const std::string& setup) {
   for (int w = 1; w < impl_->size; ++w) send(setup, w, kSetup);
   for (int answered = 1; answered < impl_->size; ++answered) {
     int tag = 0, source = 0;
-    const std::string reply = receive(MPI_ANY_SOURCE, &tag, &source);
+    std::string reply;
+    if (!receive(MPI_ANY_SOURCE, &tag, &source, &reply, impl_->rank_timeout)) {
+      for (int w = 1; w < impl_->size; ++w)
+        if (impl_->hosts[static_cast<std::size_t>(w)].empty()) throw impl_->lost_rank(w, "setting up");
+    }
     if (tag == kRefuse) throw ClusterError(impl_->who(source) + ": " + reply);
     const auto space = reply.find(' ');
     if (tag != kReady || space == std::string::npos)
@@ -359,7 +411,7 @@ Cluster::Traffic Cluster::traffic() const { return impl_->traffic; }
 
 bool Cluster::receive_setup(std::string* setup) {
   int tag = 0;
-  *setup = receive(0, &tag, nullptr);
+  receive(0, &tag, nullptr, setup);
   if (tag == kStop) {
     impl_->stopped = true;
     return false;
@@ -372,7 +424,8 @@ void Cluster::refuse_setup(const std::string& reason) {
   send(reason, 0, kRefuse);
   int tag = 0;
   while (!impl_->stopped) {
-    receive(0, &tag, nullptr);
+    std::string ignored;
+    receive(0, &tag, nullptr, &ignored);
     impl_->stopped = tag == kStop;
   }
 }
@@ -432,6 +485,9 @@ void Cluster::serve(const DiversityProblem& problem, int threads, Encode encode)
 
   Backoff backoff;
   std::string bytes;
+  // Tasks received and not yet answered, and when this rank last sent rank 0 anything.
+  int outstanding = 0;
+  auto last_sent = std::chrono::steady_clock::now();
   try {
     while (!impl_->stopped) {
       std::deque<Done> ready;
@@ -442,6 +498,16 @@ void Cluster::serve(const DiversityProblem& problem, int threads, Encode encode)
         ready.swap(done);
       }
       for (const Done& d : ready) send(d.bytes, 0, d.fail ? kFail : kResult);
+      const auto now = std::chrono::steady_clock::now();
+      outstanding -= static_cast<int>(ready.size());
+      if (!ready.empty()) {
+        last_sent = now;
+      } else if (outstanding > 0 && std::chrono::duration<double>(now - last_sent).count() >= kBeatSeconds) {
+        // Still evaluating: tell rank 0 this rank is alive (results may take long).
+        const std::string beat = with_header(Header{}, "", 0);
+        send(beat, 0, kBeat);
+        last_sent = now;
+      }
       int tag = 0, source = 0;
       bool any = !ready.empty();
       while (try_receive(0, &bytes, &tag, &source)) {
@@ -451,6 +517,7 @@ void Cluster::serve(const DiversityProblem& problem, int threads, Encode encode)
           break;
         }
         if (tag != kTask) throw std::logic_error("cluster: unexpected message from rank 0");
+        ++outstanding;
         {
           std::lock_guard<std::mutex> lock(mutex);
           tasks.push_back(std::move(bytes));

@@ -29,6 +29,7 @@ namespace {
 
 int Cluster::rank() const { return 0; }
 int Cluster::size() const { return 1; }
+void Cluster::set_rank_timeout(double) {}
 int Cluster::default_threads() const { return ThreadPool::hardware_threads(); }
 void Cluster::start_workers(const std::string&) { no_mpi(); }
 std::unique_ptr<BatchEvaluator> Cluster::evaluator(const DiversityProblem&, ThreadPool&, Decode) { no_mpi(); }

@@ -1,10 +1,13 @@
 #include "eval/throughput.h"
 
 #include <mujoco/mujoco.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <functional>
 
 #include "core/rng.h"
 #include "core/thread_pool.h"
@@ -24,13 +27,35 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Replays a record's inputs with plain mj_step `repeats` times; returns steps per second.
+double cpu_seconds(clockid_t clock) {
+  timespec t{};
+  clock_gettime(clock, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// Runs `work` (which returns the steps it did) until `budget` wall seconds have passed;
+// returns steps per CPU second of this thread.
+double steps_per_cpu_second(double budget, const std::function<long long()>& work) {
+  long long steps = 0;
+  const auto start = Clock::now();
+  const double cpu0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+  do {
+    steps += work();
+  } while (seconds_since(start) < budget);
+  return static_cast<double>(steps) / std::max(1e-9, cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - cpu0);
+}
+
+double load_average() {
+  double load[1] = {-1};
+  return getloadavg(load, 1) == 1 ? load[0] : -1;
+}
+
+// Replays a record's inputs with plain mj_step for `budget` wall seconds; returns steps
+// per CPU second.
 double raw_step_rate(const mjModel* shared, const StepRecorder& record, double budget) {
   mjModel* m = mj_copyModel(nullptr, shared);
   mjData* d = mj_makeData(m);
-  long long steps = 0;
-  const auto start = Clock::now();
-  do {
+  const double rate = steps_per_cpu_second(budget, [&]() -> long long {
     mj_resetData(m, d);
     std::copy(record.qpos0.begin(), record.qpos0.end(), d->qpos);
     std::copy(record.qvel0.begin(), record.qvel0.end(), d->qvel);
@@ -45,30 +70,68 @@ double raw_step_rate(const mjModel* shared, const StepRecorder& record, double b
                 record.ctrl.begin() + static_cast<long>(k + 1) * record.nu, d->ctrl);
       mj_step(m, d);
     }
-    steps += record.steps();
-  } while (seconds_since(start) < budget);
-  const double rate = static_cast<double>(steps) / seconds_since(start);
+    return record.steps();
+  });
   mj_deleteData(d);
   mj_deleteModel(m);
   return rate;
 }
 
+double median_of(std::vector<double> v) { return Spread::of(std::move(v)).median; }
+
 }  // namespace
 
+Spread Spread::of(std::vector<double> values) {
+  Spread s;
+  s.rounds = values;
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  auto quantile = [&](double q) {
+    const double at = q * static_cast<double>(values.size() - 1);
+    const std::size_t lo = static_cast<std::size_t>(std::floor(at));
+    const std::size_t hi = std::min(lo + 1, values.size() - 1);
+    return values[lo] + (at - static_cast<double>(lo)) * (values[hi] - values[lo]);
+  };
+  s.median = quantile(0.5);
+  s.min = values.front();
+  s.max = values.back();
+  s.q1 = quantile(0.25);
+  s.q3 = quantile(0.75);
+  return s;
+}
+
+nlohmann::json Spread::to_json() const {
+  return {{"median", median}, {"min", min}, {"max", max}, {"q1", q1}, {"q3", q3}, {"rounds", rounds}};
+}
+
 nlohmann::json ThroughputReport::to_json() const {
-  return {{"raw_mj_step_steps_per_second", raw_steps_per_second},
-          {"rollout_steps_per_second", rollout_steps_per_second},
-          {"rollout_over_raw", rollout_ratio},
-          {"steps_per_rollout", rollout_steps},
-          {"rollouts_per_second_1_thread", rollouts_per_second_1},
-          {"rollouts_per_second_n_threads", rollouts_per_second_n},
-          {"threads", threads},
-          {"parallel_speedup", speedup}};
+  nlohmann::json j = {{"rounds", rounds},
+                      {"seconds_per_measurement", seconds},
+                      {"raw_mj_step_steps_per_second", raw_steps_per_second},
+                      {"rollout_steps_per_second", rollout_steps_per_second},
+                      {"rollout_over_raw", rollout_ratio},
+                      {"rollout_over_raw_rounds", ratio.to_json()},
+                      {"steps_per_rollout", rollout_steps},
+                      {"rollouts_per_second_1_thread", rollouts_per_second_1},
+                      {"threads", threads},
+                      {"load_average_before", load_before},
+                      {"load_average_after", load_after}};
+  if (rollouts_per_second_n > 0) {
+    j["rollouts_per_second_n_threads"] = rollouts_per_second_n;
+    j["parallel_speedup"] = speedup;
+    j["parallel_speedup_rounds"] = speedup_spread.to_json();
+    j["cpu_share_n_threads"] = cpu_share.to_json();
+    j["parallel_speedup_cpu_span_rounds"] = speedup_cpu.to_json();
+  }
+  return j;
 }
 
 ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const ParameterSet& m0,
                                     const ThroughputOptions& options) {
   ThroughputReport report;
+  report.rounds = std::max(1, options.rounds);
+  report.seconds = options.seconds;
+  report.load_before = load_average();
   auto worker = evaluator.make_worker();
 
   // M0's inputs, recorded once.
@@ -78,23 +141,7 @@ ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const Parame
   evaluator.evaluate(m0.values(), *worker, recording);
   report.rollout_steps = record.steps();
 
-  // Interleave raw and rollout measurements so both see the same machine conditions.
-  double raw = 0, rollout = 0;
-  for (int round = 0; round < 2; ++round) {
-    raw += raw_step_rate(evaluator.model().get(), record, options.seconds / 2);
-    long long steps = 0;
-    const auto start = Clock::now();
-    do {
-      const Evaluation e = evaluator.evaluate(m0.values(), *worker);
-      steps += e.stats.steps;
-    } while (seconds_since(start) < options.seconds / 2);
-    rollout += static_cast<double>(steps) / seconds_since(start);
-  }
-  report.raw_steps_per_second = raw / 2;
-  report.rollout_steps_per_second = rollout / 2;
-  report.rollout_ratio = report.rollout_steps_per_second / report.raw_steps_per_second;
-
-  // Parallel speed-up on a batch of perturbed samples, as a generation of the optimizer.
+  // A batch of perturbed samples, as a generation of the optimizer, for the speed-up.
   report.threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
   const Eigen::VectorXd x0 = m0.normalized();
   std::vector<Eigen::VectorXd> batch;
@@ -105,23 +152,83 @@ ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const Parame
       x[j] = std::clamp(x[j] + 0.03 * rng.normal(), 0.0, 1.0);
     batch.push_back(std::move(x));
   }
-  auto batch_rate = [&](int threads) {
-    ThreadPool pool(threads);
+  struct Pool {
+    ThreadPool pool;
     std::vector<std::unique_ptr<SimWorker>> workers;
-    for (int w = 0; w < pool.size(); ++w) workers.push_back(evaluator.make_worker());
+    explicit Pool(int threads, const TaskEvaluator& evaluator) : pool(threads) {
+      for (int w = 0; w < pool.size(); ++w) workers.push_back(evaluator.make_worker());
+    }
+  };
+  Pool one(1, evaluator), many(report.threads, evaluator);
+  // Rollouts per wall second of whole batches on `p`; the process's CPU share of its
+  // threads' cores meanwhile; and rollouts per second of the batches' CPU span: each
+  // batch lasts as long as its busiest thread's CPU time, which is how long it would
+  // take on free cores (contention between the threads and an uneven end of the batch
+  // count, time spent descheduled does not).
+  struct Rates {
+    double wall = 0, cpu_span = 0, share = 0;
+  };
+  auto batch_rate = [&](Pool& p) {
     long long rollouts = 0;
+    double span = 0;
+    std::vector<double> busy(static_cast<std::size_t>(p.pool.size()));
     const auto start = Clock::now();
+    const double cpu0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
     do {
-      pool.parallel_for(batch.size(), [&](std::size_t i, int w) {
-        evaluator.evaluate_normalized(batch[i], *workers[static_cast<std::size_t>(w)]);
+      std::fill(busy.begin(), busy.end(), 0.0);
+      p.pool.parallel_for(batch.size(), [&](std::size_t i, int w) {
+        const double t0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+        evaluator.evaluate_normalized(batch[i], *p.workers[static_cast<std::size_t>(w)]);
+        busy[static_cast<std::size_t>(w)] += cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - t0;
       });
+      span += *std::max_element(busy.begin(), busy.end());
       rollouts += static_cast<long long>(batch.size());
     } while (seconds_since(start) < options.seconds);
-    return static_cast<double>(rollouts) / seconds_since(start);
+    const double wall = seconds_since(start);
+    Rates r;
+    r.wall = static_cast<double>(rollouts) / wall;
+    r.cpu_span = static_cast<double>(rollouts) / std::max(1e-9, span);
+    r.share = (cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0) / (wall * static_cast<double>(p.pool.size()));
+    return r;
   };
-  report.rollouts_per_second_1 = batch_rate(1);
-  report.rollouts_per_second_n = batch_rate(report.threads);
-  report.speedup = report.rollouts_per_second_n / report.rollouts_per_second_1;
+
+  std::vector<double> raw, rollout, ratio, rate1, rate_n, speedup, speedup_cpu, share;
+  for (int round = 0; round < report.rounds; ++round) {
+    double r = 0, o = 0;
+    Rates one_rate, n_rate;
+    auto measure_raw = [&] { r = raw_step_rate(evaluator.model().get(), record, options.seconds); };
+    auto measure_rollout = [&] {
+      o = steps_per_cpu_second(options.seconds, [&]() -> long long {
+        return evaluator.evaluate(m0.values(), *worker).stats.steps;
+      });
+    };
+    auto measure_one = [&] { one_rate = batch_rate(one); };
+    auto measure_many = [&] { n_rate = batch_rate(many); };
+    if (round % 2 == 0) {
+      measure_raw(); measure_rollout(); measure_one(); measure_many();
+    } else {
+      measure_many(); measure_one(); measure_rollout(); measure_raw();
+    }
+    raw.push_back(r);
+    rollout.push_back(o);
+    ratio.push_back(o / r);
+    rate1.push_back(one_rate.wall);
+    rate_n.push_back(n_rate.wall);
+    speedup.push_back(n_rate.wall / one_rate.wall);
+    speedup_cpu.push_back(n_rate.cpu_span / one_rate.cpu_span);
+    share.push_back(n_rate.share);
+  }
+  report.raw_steps_per_second = median_of(raw);
+  report.rollout_steps_per_second = median_of(rollout);
+  report.ratio = Spread::of(ratio);
+  report.rollout_ratio = report.ratio.median;
+  report.rollouts_per_second_1 = median_of(rate1);
+  report.rollouts_per_second_n = median_of(rate_n);
+  report.speedup_spread = Spread::of(speedup);
+  report.speedup = report.speedup_spread.median;
+  report.cpu_share = Spread::of(share);
+  report.speedup_cpu = Spread::of(speedup_cpu);
+  report.load_after = load_average();
   return report;
 }
 
@@ -168,29 +275,44 @@ ThroughputReport measure_stance_throughput(const std::string& character_file,
   };
 
   ThroughputReport report;
+  report.rounds = std::max(1, options.rounds);
+  report.seconds = options.seconds;
+  report.load_before = load_average();
   StepRecorder record;
   stand(&record);
   report.rollout_steps = record.steps();
-  double raw = 0, rollout = 0;
-  long long rollouts = 0;
-  double rollout_time = 0;
-  for (int round = 0; round < 2; ++round) {
-    raw += raw_step_rate(model->get(), record, options.seconds / 2);
-    long long n = 0;
-    const auto start = Clock::now();
-    do {
-      n += stand(nullptr).steps;
-      ++rollouts;
-    } while (seconds_since(start) < options.seconds / 2);
-    const double elapsed = seconds_since(start);
-    rollout_time += elapsed;
-    rollout += static_cast<double>(n) / elapsed;
+  std::vector<double> raw, rollout, ratio, per_second;
+  for (int round = 0; round < report.rounds; ++round) {
+    double r = 0, o = 0;
+    long long rollouts = 0;
+    Clock::time_point start;
+    double wall = 0;
+    auto measure_raw = [&] { r = raw_step_rate(model->get(), record, options.seconds); };
+    auto measure_rollout = [&] {
+      start = Clock::now();
+      o = steps_per_cpu_second(options.seconds, [&]() -> long long {
+        ++rollouts;
+        return stand(nullptr).steps;
+      });
+      wall = seconds_since(start);
+    };
+    if (round % 2 == 0) {
+      measure_raw(); measure_rollout();
+    } else {
+      measure_rollout(); measure_raw();
+    }
+    raw.push_back(r);
+    rollout.push_back(o);
+    ratio.push_back(o / r);
+    per_second.push_back(static_cast<double>(rollouts) / wall);
   }
-  report.raw_steps_per_second = raw / 2;
-  report.rollout_steps_per_second = rollout / 2;
-  report.rollout_ratio = report.rollout_steps_per_second / report.raw_steps_per_second;
-  report.rollouts_per_second_1 = static_cast<double>(rollouts) / rollout_time;
+  report.raw_steps_per_second = median_of(raw);
+  report.rollout_steps_per_second = median_of(rollout);
+  report.ratio = Spread::of(ratio);
+  report.rollout_ratio = report.ratio.median;
+  report.rollouts_per_second_1 = median_of(per_second);
   report.threads = 1;
+  report.load_after = load_average();
   return report;
 }
 

@@ -11,7 +11,8 @@
 // alignment step, so distances do not depend on where in the world (x, y and z) a motion
 // happens. Only the translation is aligned, not the heading: the same motion performed
 // facing another way is a different motion to every metric (its root orientation and
-// its link positions in world axes differ).
+// its link positions in world axes differ). A walk's poses come already turned into the
+// stride's heading frame (task/walk_eval.h), so for walks the direction does not count.
 //
 // Pose distances (paper section 4.1), between poses x and x':
 //   HF  (hands + feet):          sum over hands and feet   |x_i - x'_i|^2            (m^2)

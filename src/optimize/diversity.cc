@@ -105,16 +105,18 @@ const char* to_string(DiversityStrategy strategy) {
     case DiversityStrategy::kRoundRobin: return "round-robin";
     case DiversityStrategy::kProgressive: return "progressive";
     case DiversityStrategy::kJoint: return "joint";
+    case DiversityStrategy::kSimultaneous: return "simultaneous";
   }
   return "?";
 }
 
 DiversityStrategy parse_strategy(const std::string& name, const std::string& where) {
   for (DiversityStrategy s : {DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive,
-                              DiversityStrategy::kJoint}) {
+                              DiversityStrategy::kJoint, DiversityStrategy::kSimultaneous}) {
     if (name == to_string(s)) return s;
   }
-  throw UserError(where + ": expected one of round-robin, progressive, joint, got '" + name + "'");
+  throw UserError(where + ": expected one of round-robin, progressive, joint, simultaneous, got '" +
+                  name + "'");
 }
 
 const char* to_string(ConstraintRule rule) {
@@ -383,6 +385,9 @@ bool DiversityOptimizer::step() {
     case DiversityStrategy::kJoint:
       step_joint();
       break;
+    case DiversityStrategy::kSimultaneous:
+      step_simultaneous();
+      break;
   }
   end_generation();
   return !done();
@@ -438,6 +443,79 @@ void DiversityOptimizer::count_samples(const std::vector<std::shared_ptr<const O
   step_feasible_ = 0;
   for (std::size_t k = 0; k < n; ++k)
     if (scored_constraint(*outcomes[k]) == 0.0) ++step_feasible_;
+}
+
+void DiversityOptimizer::step_simultaneous() {
+  const int n = options_.variations;
+  // Every instance still running draws its generation; one batch holds them all.
+  std::vector<int> active;
+  std::vector<std::vector<Eigen::VectorXd>> xs(static_cast<std::size_t>(n) + 1);
+  std::vector<Eigen::VectorXd> batch;
+  std::vector<std::size_t> first(static_cast<std::size_t>(n) + 1, 0);
+  for (int v = 1; v <= n; ++v) {
+    if (cmas_[v - 1].stop_reason() != StopReason::kNone) continue;
+    active.push_back(v);
+    xs[v] = cmas_[v - 1].ask();
+    first[v] = batch.size();
+    batch.insert(batch.end(), xs[v].begin(), xs[v].end());
+  }
+  if (active.empty()) return;
+  const auto outcomes = evaluate_all(batch);
+  evaluations_ += static_cast<long long>(batch.size());
+  count_samples(outcomes, batch.size());
+
+  // Each sample of variation v replaces M_v in the set as it stood when the generation
+  // was drawn, ranked by its D and its own C; every instance learns from that.
+  std::vector<double> D(batch.size()), C(batch.size());
+  std::vector<int> owner(batch.size());
+  for (int v : active)
+    for (std::size_t k = 0; k < xs[v].size(); ++k) owner[first[v] + k] = v;
+  pool_->parallel_for(batch.size(), [&](std::size_t k, int) {
+    D[k] = replaced_objective(*problem_, outcomes_, current_, owner[k], *outcomes[k], options_.k);
+    C[k] = scored_constraint(*outcomes[k]);
+  });
+  for (int v : active) {
+    const auto begin = static_cast<std::ptrdiff_t>(first[v]);
+    const auto end = begin + static_cast<std::ptrdiff_t>(xs[v].size());
+    cmas_[v - 1].tell(fitness(std::vector<double>(C.begin() + begin, C.begin() + end),
+                              std::vector<double>(D.begin() + begin, D.begin() + end)));
+  }
+
+  if (options_.point == VariationPoint::kBestSample) {
+    // The variations move one after another, in order 1..N, each to its best sample if
+    // that beats where it stands among the others as they now stand (some moved a moment
+    // ago): ranked as in round-robin, so two variations never step onto the same ground
+    // and the current set never gets worse. Costs distances only, no rollout.
+    for (int v : active) {
+      const std::size_t lambda = xs[v].size();
+      std::vector<double> Dv(lambda), Cv(lambda);
+      pool_->parallel_for(lambda, [&](std::size_t k, int) {
+        const Outcome& o = *outcomes[first[v] + k];
+        Dv[k] = replaced_objective(*problem_, outcomes_, current_, v, o, options_.k);
+        Cv[k] = scored_constraint(o);
+      });
+      Dv.push_back(current_.D);
+      Cv.push_back(current_.constraint[v]);
+      const std::size_t best = best_candidate(Cv, Dv);
+      if (best < lambda) {
+        points_[v] = xs[v][best];
+        outcomes_[v] = outcomes[first[v] + best];
+        rescore();
+      }
+    }
+    finish_step(0);
+    return;
+  }
+  // The paper's choice: every variation stands at its new mean, evaluated in one batch.
+  std::vector<Eigen::VectorXd> means;
+  for (int v : active) means.push_back(cmas_[v - 1].mean());
+  const auto mean_outcomes = evaluate_all(means);
+  evaluations_ += static_cast<long long>(means.size());
+  for (std::size_t i = 0; i < active.size(); ++i) {
+    points_[active[i]] = means[i];
+    outcomes_[active[i]] = mean_outcomes[i];
+  }
+  finish_step(0);
 }
 
 void DiversityOptimizer::settle_pending(std::shared_ptr<const Outcome> outcome) {

@@ -15,14 +15,27 @@
 //                at the best set found in its phase.
 //   joint        (baseline) one CMA-ES instance over all N x |P| parameters; a sample is
 //                a whole set M_1..M_N.
+//   simultaneous N CMA-ES instances as in round-robin, but every variation draws its
+//                generation at once: one batch of N x lambda rollouts (what keeps many
+//                cores busy; round-robin's batches hold lambda). Each sample replaces M_i
+//                in the set as it stood when the generation was drawn; each instance is
+//                told those scores. Then the variations move one after another (1..N),
+//                each to its best sample if that beats it among the others as they now
+//                stand (best-sample; ranked as round-robin ranks), or all to their new
+//                means, evaluated in one more batch of N (mean). What it gives up against
+//                round-robin: variation i's samples do not see the moves variations
+//                1..i-1 made in the same generation (docs/results.md compares them).
 //
 // Generations. One generation costs N x lambda evaluations in every strategy, so budgets
 // compare directly:
 //   round-robin  one CMA generation of each variation, in order 1..N;
 //   progressive  N CMA generations of the newest variation;
 //   joint        one CMA generation (lambda samples, each N evaluations) of the joint
-//                instance.
-// A "step" is one CMA generation of one instance; the log has one record per step.
+//                instance;
+//   simultaneous one CMA generation of every variation, in one batch.
+// A "step" is one CMA generation of one instance (joint: of the joint instance;
+// simultaneous: of all N at once); the log has one record per step, with variation 0
+// for joint and simultaneous.
 // With VariationPoint::kMean, on top of the sample evaluations, the mean of every instance
 // that moved is evaluated again (one evaluation per variation per step): its outcome is
 // what the other variations' samples are scored against. `evaluations` counts both. That
@@ -92,7 +105,7 @@
 
 namespace diverse {
 
-enum class DiversityStrategy { kRoundRobin, kProgressive, kJoint };
+enum class DiversityStrategy { kRoundRobin, kProgressive, kJoint, kSimultaneous };
 enum class ConstraintRule { kDominant, kPenalty };
 enum class VariationPoint { kBestSample, kMean };
 // "best-sample", "mean".
@@ -106,10 +119,10 @@ const char* to_string(ConstraintRule rule);
 // 'NAME'".
 ConstraintRule parse_constraint_rule(const std::string& name,
                                      const std::string& where = "--constraints");
-// "round-robin", "progressive", "joint".
+// "round-robin", "progressive", "joint", "simultaneous".
 const char* to_string(DiversityStrategy strategy);
 // Parses the names above; throws UserError "WHERE: expected one of round-robin,
-// progressive, joint, got 'NAME'".
+// progressive, joint, simultaneous, got 'NAME'".
 DiversityStrategy parse_strategy(const std::string& name, const std::string& where = "--strategy");
 
 struct DiversityOptions {
@@ -245,6 +258,7 @@ class DiversityOptimizer {
   int present() const;  // motions in the current set, M_0 included
   void step_variation(int variation);
   void step_joint();
+  void step_simultaneous();
   void rescore();
   void settle_pending(std::shared_ptr<const Outcome> outcome);
   void finish_step(int variation);

@@ -15,6 +15,7 @@
 #include "metric/metric.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "render/run_problem.h"
 #include "render/view_plan.h"
 
 // Where the build put the page template (set for this file by the top-level CMakeLists).
@@ -85,12 +86,6 @@ bool on_path(const std::string& program) {
   return false;
 }
 
-std::string stem(char prefix, std::size_t i) {
-  std::string s(1, prefix);
-  s.append(std::to_string(i));
-  return s;
-}
-
 // Adds `model` to the page's models unless an identical one is there; returns its index.
 int add_model(nlohmann::json& models, const mjModel* model) {
   nlohmann::json j = model_json(model);
@@ -100,103 +95,18 @@ int add_model(nlohmann::json& models, const mjModel* model) {
   return static_cast<int>(models.size()) - 1;
 }
 
-// Named parameters from a path or motion file, as `like` names them (the controller's,
-// and the shape scales of a run whose shape varied). A value written from a normalized
-// coordinate of exactly 0 or 1 can miss its bound by a rounding error (lower + 1 * (upper -
-// lower) != upper); such values are put back on the bound before the strict check.
-ParameterSet named_parameters(const ParameterSet& like, nlohmann::json values,
-                              const std::string& origin) {
-  ParameterSet set = like;
-  if (values.is_object()) {
-    for (const ParamSpec& spec : set.specs()) {
-      auto it = values.find(spec.name);
-      if (it == values.end() || !it->is_number()) continue;
-      const double v = it->get<double>();
-      const double slack = 1e-9 * std::abs(spec.upper - spec.lower);
-      if (v > spec.upper && v <= spec.upper + slack) *it = spec.upper;
-      if (v < spec.lower && v >= spec.lower - slack) *it = spec.lower;
-    }
-  }
-  set.set_from_json(values, origin);
-  return set;
-}
-
-ParameterSet motion_parameters(const ParameterSet& like, const fs::path& motion_file) {
-  const nlohmann::json motion = read_json(motion_file);
-  if (!motion.is_object() || !motion.contains("parameters"))
-    throw_field_error(motion_file.string(), "parameters", "the motion's named controller parameters");
-  return named_parameters(like, motion["parameters"], motion_file.string());
-}
-
-// One point of a variation's path: its parameters and where it comes from.
-struct PathPoint {
-  Eigen::VectorXd x;     // normalized parameters
-  int generation = -1;
-  int step = -1;
-  bool result = false;   // the variation's result (motions/m<i>.json)
-};
-
-std::vector<PathPoint> read_path(const RunView& run, std::size_t variation,
-                                 const ParameterSet& like) {
-  const fs::path file = run.dir / "paths" / (stem('m', variation) + ".json");
-  if (!fs::exists(file))
-    throw UserError(file.string() + ": missing; the run directory is incomplete (`diverse resume " +
-                    run.dir.string() + "` writes its outputs again)");
-  const nlohmann::json path = read_json(file);
-  if (!path.is_object() || !path.contains("points") || !path["points"].is_array())
-    throw_field_error(file.string(), "points", "a list of path points");
-  std::vector<PathPoint> points;
-  for (std::size_t k = 0; k < path["points"].size(); ++k) {
-    const nlohmann::json& p = path["points"][k];
-    const std::string field = "points[" + std::to_string(k) + "]";
-    if (!p.is_object() || !p.contains("parameters"))
-      throw_field_error(file.string(), field, "an object with \"parameters\"");
-    const ParameterSet set = named_parameters(like, p["parameters"], file.string() + ": " + field);
-    points.push_back({set.normalized(), p.value("generation", -1), p.value("step", -1), false});
-  }
-  const ParameterSet result = motion_parameters(like, run.motions[variation].file);
-  points.push_back({result.normalized(), -1, -1, true});
-  return points;
-}
-
 // The path points' data: distances from M0 of (up to max_path_candidates of) every path's
 // points, the picked points simulated again with recording on.
 nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nlohmann::json& models) {
-  const fs::path run_file = run.dir / "run.json";
-  const std::string task_file = run.run.value("task_file", std::string());
-  const std::string what = " the optimization paths cannot be simulated (restore it, or make "
-                           "the gallery with --no-paths)";
-  if (task_file.empty() || !fs::exists(task_file))
-    throw UserError(run_file.string() + ": task_file: " + task_file + " is missing;" + what);
-  if (read_file(task_file) != run.run.value("task_text", std::string()))
-    throw UserError(run_file.string() + ": task_file: " + task_file + " changed since the run;" + what);
-  // The run's strength model and bounds (absent in older runs: 1 and none), so that the
-  // path points are simulated and judged as the run judged its samples.
-  Task task = load_task(task_file);
-  const nlohmann::json strength = run.run.value("strength", nlohmann::json(1.0));
-  if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
-    throw_field_error(run_file.string(), "strength", "expected a number in [0.1, 10]");
-  task.strength = strength.get<double>();
-  const MotionBounds bounds =
-      motion_bounds_from_json(run.run.value("bounds", nlohmann::json()), run_file.string());
-  const TaskEvaluator evaluator(std::move(task));
-  const DistanceSpec distance =
-      parse_distance(run.metric, run.run.value("shape_weight", kDefaultShapeWeight),
-                     (run.dir / "summary.json").string() + ": metric", run_file.string() + ": shape_weight");
-  // A run whose shape varied names its shape scales after the controller's parameters.
-  const nlohmann::json vary = run.run.value("vary", nlohmann::json::array());
-  const bool vary_shape = std::find(vary.begin(), vary.end(), "shape") != vary.end();
-  ParameterSet like = evaluator.parameters();
-  if (vary_shape) like = evaluator.with_shape(like, evaluator.shapes().identity());
-  const ParameterSet m0 = motion_parameters(like, run.motions[0].file);
-
-  const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
-  const MotionProblem problem(evaluator, distance, m0.normalized(), threads, vary_shape, bounds);
+  const RunProblem rp = open_run_problem(
+      run, options.threads, "the optimization paths cannot be simulated (restore it, or make the gallery with --no-paths)");
+  const MotionProblem& problem = *rp.problem;
+  const int threads = problem.workers();
   ThreadPool pool(threads);
 
   // Which points of each path are simulated to measure distances: all, or evenly spaced.
   const std::size_t variations = run.motions.size() - 1;
-  std::vector<std::vector<PathPoint>> paths(variations + 1);
+  std::vector<std::vector<RunPathPoint>> paths(variations + 1);
   std::vector<std::vector<int>> candidates(variations + 1);
   struct Job {
     std::size_t variation = 0;
@@ -204,7 +114,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   };
   std::vector<Job> jobs;
   for (std::size_t v = 1; v <= variations; ++v) {
-    paths[v] = read_path(run, v, like);
+    paths[v] = read_run_path(run, v, rp.like);
     const int n = static_cast<int>(paths[v].size());
     const int want = std::max(2, options.max_path_candidates);
     for (int k = 0; k < std::min(n, want); ++k) {
@@ -258,7 +168,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   // result is its recorded motion, exactly as the run left it.
   pool.parallel_for(picks.size(), [&](std::size_t i, int) {
     Pick& pick = picks[i];
-    const PathPoint& point = paths[pick.variation][static_cast<std::size_t>(pick.point)];
+    const RunPathPoint& point = paths[pick.variation][static_cast<std::size_t>(pick.point)];
     if (point.result) {
       const RunMotion& m = run.motions[pick.variation];
       pick.frames = body_frames_json(m.model->get(), m.sample(options.fps));
@@ -279,7 +189,7 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
     nlohmann::json points = nlohmann::json::array();
     for (const Pick& pick : picks) {
       if (pick.variation != v) continue;
-      const PathPoint& point = paths[v][static_cast<std::size_t>(pick.point)];
+      const RunPathPoint& point = paths[v][static_cast<std::size_t>(pick.point)];
       const RunMotion& m = run.motions[v];
       const double c = point.result ? m.constraint : pick.outcome->constraint;
       const bool failed = point.result ? m.failed : pick.outcome->failed;
@@ -306,6 +216,70 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
                    {"points", points}});
   }
   return out;
+}
+
+// The run's blends (RUN/blend/, run/blend.h) as the page plays them; null when there are
+// none, or (with a note) when they were made from another run in this directory.
+nlohmann::json blend_data(const RunView& run, const GalleryOptions& options, nlohmann::json& models,
+                          nlohmann::json& notes) {
+  const fs::path dir = run.dir / "blend";
+  const fs::path file = dir / "summary.json";
+  if (!options.blends || !fs::exists(file)) return nullptr;
+  const std::string remedy = "the blends are incomplete (`diverse blend " + run.dir.string() + "` makes them again)";
+  const nlohmann::json b = read_json(file);
+  if (!b.is_object() || b.value("format", "") != "diverse.blend")
+    throw_field_error(file.string(), "format", "\"diverse.blend\" (written by `diverse blend`)");
+  if (b.value("run_fingerprint", "") != run_fingerprint(run)) {
+    notes.push_back("blends left out: " + dir.string() + " was made from an earlier run in this directory (`diverse blend " +
+                    run.dir.string() + "` makes them again)");
+    return nullptr;
+  }
+  if (!b.contains("blends") || !b["blends"].is_array())
+    throw_field_error(file.string(), "blends", "a list of blends");
+  const std::size_t vertices = run.motions.size();
+  std::vector<RunMotion> motions(b["blends"].size());
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const nlohmann::json& e = b["blends"][k];
+    const std::string field = "blends[" + std::to_string(k) + "]";
+    if (!e.is_object() || !e.contains("file") || !e["file"].is_string() || !e.contains("label") ||
+        !e["label"].is_string())
+      throw_field_error(file.string(), field, "an object with the blend's \"label\" and motion \"file\"");
+    if (!e.contains("weights") || !e["weights"].is_array() || e["weights"].size() != vertices)
+      throw_field_error(file.string(), field + ".weights", "one weight per motion of the run (" +
+                                                               std::to_string(vertices) + ")");
+    for (const auto& w : e["weights"])
+      if (!w.is_number()) throw_field_error(file.string(), field + ".weights", "numbers");
+    motions[k] = load_motion_file(dir / e["file"].get<std::string>(), e["label"].get<std::string>(), remedy);
+  }
+  std::vector<nlohmann::json> frames(motions.size());
+  const int threads = options.threads > 0 ? options.threads : ThreadPool::hardware_threads();
+  ThreadPool pool(threads);
+  pool.parallel_for(motions.size(), [&](std::size_t k, int) {
+    frames[k] = body_frames_json(motions[k].model->get(), motions[k].sample(options.fps));
+  });
+  nlohmann::json points = nlohmann::json::array();
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const nlohmann::json& e = b["blends"][k];
+    points.push_back({{"label", e["label"]},
+                      {"weights", e["weights"]},
+                      {"constraint", e.value("constraint", nlohmann::json(nullptr))},
+                      {"failed", e.value("failed", false)},
+                      {"fell", e.value("fell", false)},
+                      {"feasible", e.value("feasible", false)},
+                      {"distances", e.value("distances", nlohmann::json::array())},
+                      {"nearest", e.value("nearest", nlohmann::json(nullptr))},
+                      {"model", add_model(models, motions[k].model->get())},
+                      {"duration", motions[k].duration()},
+                      {"frames", std::move(frames[k])}});
+  }
+  const nlohmann::json paths = b.value("paths", nlohmann::json::object());
+  return {{"samples", b.value("samples", 0)},
+          {"seed", b.value("seed", 0)},
+          {"feasible", b.value("feasible", 0)},
+          {"feasible_fraction", b.value("feasible_fraction", nlohmann::json(nullptr))},
+          {"path_points", paths.value("points", 0)},
+          {"path_feasible_fraction", paths.value("feasible_fraction", nlohmann::json(nullptr))},
+          {"points", points}};
 }
 
 // The run's progress per generation from log.jsonl (one record per CMA step; a generation's
@@ -542,6 +516,7 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
     data["paths"] = nlohmann::json::array();
     if (!options.paths) data["notes"].push_back("optimization paths left out (--no-paths)");
   }
+  data["blend"] = blend_data(run, options, models, data["notes"]);
   data["models"] = models;
   return data;
 }

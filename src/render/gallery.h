@@ -26,7 +26,12 @@
 //   - the run's progress for the plots panel, from log.jsonl: per generation (the last CMA
 //     step of each), D of the current set, D of the best set so far, and every motion's
 //     constraint value C and dmin; at most max_progress_points generations, thinned evenly;
-//   - for a run whose bodies varied, every motion's link-length scales (summary.json).
+//   - for a run whose bodies varied, every motion's link-length scales (summary.json);
+//   - the run's blends, when `diverse blend RUN` made them (run/blend.h, RUN/blend/): per
+//     blend its weights on M0..MN, C, whether it meets the task, its distances to the
+//     motions and its frames (from its motion file), and the share that meets the task,
+//     against the path points'. Blends made from an earlier run in the same directory
+//     (another run_fingerprint) are left out with a note.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -46,6 +51,7 @@ struct GalleryOptions {
   bool paths = true;              // simulate optimization path points (needs the task file)
   std::vector<double> path_fractions{0.0, 0.25, 0.5, 0.75, 1.0};
   int max_path_candidates = 64;   // path points per variation simulated to measure distances
+  bool blends = true;             // the run's blends (RUN/blend/), if it has any
   int max_progress_points = 400;  // generations of log.jsonl kept for the plots (thinned evenly)
   int threads = 0;                // simulation threads; 0 = one per core
   std::filesystem::path page_template;  // "" = gallery_template_path()

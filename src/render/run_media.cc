@@ -31,32 +31,36 @@ std::string numbered(char prefix, std::size_t i) {
   return s;
 }
 
-std::string incomplete(const fs::path& file, const fs::path& dir) {
-  return file.string() + ": missing; the run directory is incomplete (`diverse resume " +
-         dir.string() + "` writes its outputs again)";
-}
-
 RunMotion read_motion(const fs::path& dir, std::size_t i, const nlohmann::json& entry) {
-  RunMotion m;
-  m.index = static_cast<int>(i);
-  m.label = numbered('M', i);
-  m.file = dir / "motions" / (numbered('m', i) + ".json");
+  const fs::path file = dir / "motions" / (numbered('m', i) + ".json");
   const std::string summary = (dir / "summary.json").string();
   const std::string field = "motions[" + std::to_string(i) + "]";
   if (!entry.is_object() || !entry.contains("constraint") || !entry["constraint"].is_number())
     throw_field_error(summary, field, "an object with the motion's \"constraint\"");
+  const std::string remedy = "the run directory is incomplete (`diverse resume " + dir.string() +
+                             "` writes its outputs again)";
+  RunMotion m = load_motion_file(file, numbered('M', i), remedy);
+  m.index = static_cast<int>(i);
   m.constraint = entry["constraint"].get<double>();
   m.dmin = entry.value("dmin", 0.0);
   m.fell = entry.value("fell", false);
   m.failed = entry.value("failed", false);
   if (entry.contains("label") && entry["label"].is_string()) m.label = entry["label"];
+  return m;
+}
 
-  if (!fs::exists(m.file)) throw UserError(incomplete(m.file, dir));
+}  // namespace
+
+RunMotion load_motion_file(const fs::path& file, const std::string& label, const std::string& remedy) {
+  RunMotion m;
+  m.label = label;
+  m.file = file;
+  if (!fs::exists(m.file)) throw UserError(m.file.string() + ": missing; " + remedy);
   const nlohmann::json motion = read_json(m.file);
   m.record = read_replay_record(motion, m.file, &m.model_path);
   m.model_path = m.model_path.lexically_normal();
   if (m.record.nq <= 0) throw_field_error(m.file.string(), "replay.nq", "a positive number");
-  if (!fs::exists(m.model_path)) throw UserError(incomplete(m.model_path, dir));
+  if (!fs::exists(m.model_path)) throw UserError(m.model_path.string() + ": missing; " + remedy);
   m.model = SharedModel::from_file(m.model_path.string());
   if (m.model->get()->nq != m.record.nq)
     throw UserError(m.file.string() + ": replay.nq: " + std::to_string(m.record.nq) +
@@ -81,6 +85,8 @@ RunMotion read_motion(const fs::path& dir, std::size_t i, const nlohmann::json& 
   }
   return m;
 }
+
+namespace {
 
 // Draws a motion's label and status into the top-left corner of its tile.
 void label_tile(Image& tile, const RunMotion& m, const std::string& note) {

@@ -58,6 +58,12 @@ struct RunMotion {
   std::string status() const;
 };
 
+// Reads one motion file (io/motion_record.h) with its model and phases, labelled `label`;
+// the caller fills in index, constraint, dmin, fell and failed. Throws UserError on a
+// missing or malformed file: "FILE: missing; <remedy>" for a missing motion or model file.
+RunMotion load_motion_file(const std::filesystem::path& file, const std::string& label,
+                           const std::string& remedy);
+
 // A finished run directory, read for viewing.
 struct RunView {
   std::filesystem::path dir;

@@ -190,6 +190,7 @@ void write_run_outputs(const RunOutputs& o) {
          o.wall_seconds > 0 ? static_cast<double>(result.evaluations) / o.wall_seconds : 0.0}}}};
   if (objective.combined()) summary["shape_weight"] = objective.shape_weight;
   if (!o.messages.is_null()) summary["timing"]["messages"] = o.messages;
+  if (!o.rollouts.is_null()) summary["timing"]["rollouts"] = o.rollouts;
   write_json_atomic(o.dir / "summary.json", summary);
 
   // The film strip is drawn from the files just written, as `diverse render` draws it.

@@ -25,6 +25,7 @@ struct RunOutputs {
   bool render = true;
   int ranks = 1;            // processes that evaluated (mpirun -n; distribute/cluster.h)
   nlohmann::json messages = nullptr;  // ranks > 1: what went between them ("timing" "messages")
+  nlohmann::json rollouts = nullptr;  // one process: its rollouts' CPU times ("timing" "rollouts")
 };
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"

@@ -1,5 +1,7 @@
 #include "run/run.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -116,13 +118,23 @@ std::string cluster_setup(const RunSetup& setup) {
   return j.dump();
 }
 
+// How an interrupted run continues: "`diverse resume DIR` continues from ...".
+std::string resume_hint(const fs::path& dir, long long generation) {
+  return "`diverse resume " + dir.string() + "` continues from " +
+         (generation >= 0 ? "the last checkpoint (generation " + std::to_string(generation) + ")"
+                          : std::string("the start (run.json holds the settings)"));
+}
+
 // The line rank 0 prints when mpirun stops it (a worker died, or the job was interrupted).
 std::string stopped_line(const fs::path& dir, long long generation) {
   return "diverse: error: the run was stopped by mpirun (a rank ended, e.g. killed or its "
-         "node lost, or the job was interrupted; mpirun names which); `diverse resume " +
-         dir.string() + "` continues from " +
-         (generation >= 0 ? "the last checkpoint (generation " + std::to_string(generation) + ")"
-                          : std::string("the start (run.json holds the settings)"));
+         "node lost, or the job was interrupted; mpirun names which); " +
+         resume_hint(dir, generation);
+}
+
+// A failure of another rank, with how to continue the run.
+[[noreturn]] void rethrow_resumable(const ClusterError& e, const fs::path& dir, long long generation) {
+  throw ClusterError(std::string(e.what()) + "; " + resume_hint(dir, generation));
 }
 
 // summary.json's timing.messages: this session's traffic between the ranks.
@@ -143,10 +155,65 @@ nlohmann::json messages_json(const Cluster::Traffic& t) {
           {"overhead_us_per_evaluation", 1e6 * (t.round_trip_seconds - t.compute_seconds) / n}};
 }
 
+// One process: a batch on the thread pool, as the optimizer runs it by default, with
+// every rollout's CPU time (its thread's, so time spent descheduled by other jobs does
+// not count) and the batch sizes kept for summary.json's timing.rollouts: what
+// scripts/scaling-model.py models many ranks from.
+class TimedPoolEvaluator : public BatchEvaluator {
+ public:
+  TimedPoolEvaluator(const DiversityProblem& problem, ThreadPool& pool) : problem_(problem), pool_(pool) {}
+
+  std::vector<std::shared_ptr<const Outcome>> evaluate(const std::vector<Eigen::VectorXd>& xs) override {
+    std::vector<std::shared_ptr<const Outcome>> outcomes(xs.size());
+    std::vector<double> ms(xs.size());
+    pool_.parallel_for(xs.size(), [&](std::size_t k, int worker) {
+      const double t0 = thread_cpu_seconds();
+      outcomes[k] = problem_.evaluate(xs[k], worker);
+      ms[k] = 1e3 * (thread_cpu_seconds() - t0);
+    });
+    cpu_ms_.insert(cpu_ms_.end(), ms.begin(), ms.end());
+    batch_sizes_.push_back(static_cast<long long>(xs.size()));
+    return outcomes;
+  }
+
+  // {"count", "cpu_ms": {"mean", "deciles": [p0, p10, ..., p100]}, "batches", "batch_size":
+  // {"min", "max", "mean"}}; null before any batch.
+  nlohmann::json to_json() const {
+    if (cpu_ms_.empty()) return nullptr;
+    std::vector<double> sorted = cpu_ms_;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<double> deciles;
+    for (int q = 0; q <= 10; ++q)
+      deciles.push_back(sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1) / 10.0 + 0.5)]);
+    double sum = 0;
+    for (double v : sorted) sum += v;
+    long long total = 0;
+    for (long long b : batch_sizes_) total += b;
+    return {{"count", sorted.size()},
+            {"cpu_ms", {{"mean", sum / static_cast<double>(sorted.size())}, {"deciles", deciles}}},
+            {"batches", batch_sizes_.size()},
+            {"batch_size", {{"min", *std::min_element(batch_sizes_.begin(), batch_sizes_.end())},
+                            {"max", *std::max_element(batch_sizes_.begin(), batch_sizes_.end())},
+                            {"mean", static_cast<double>(total) / static_cast<double>(batch_sizes_.size())}}}};
+  }
+
+ private:
+  static double thread_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  }
+
+  const DiversityProblem& problem_;
+  ThreadPool& pool_;
+  std::vector<double> cpu_ms_;
+  std::vector<long long> batch_sizes_;
+};
+
 // Rank 0 of several: workers get the settings; batches go over every rank.
 std::unique_ptr<BatchEvaluator> cluster_evaluator(Cluster* cluster, const RunSetup& setup,
                                                   const MotionProblem& problem, ThreadPool& pool) {
-  if (!cluster) return nullptr;
+  if (!cluster) return std::make_unique<TimedPoolEvaluator>(problem, pool);
   cluster->start_workers(cluster_setup(setup));
   return cluster->evaluator(problem, pool, &MotionProblem::decode);
 }
@@ -155,7 +222,8 @@ std::unique_ptr<BatchEvaluator> cluster_evaluator(Cluster* cluster, const RunSet
 // the outputs at the end.
 void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& problem,
            DiversityOptimizer& optimizer, ThreadPool& pool, double wall_before,
-           double checkpoint_seconds, bool quiet, bool render, Cluster* cluster) {
+           double checkpoint_seconds, bool quiet, bool render, Cluster* cluster,
+           const BatchEvaluator* batch) {
   const auto started = std::chrono::steady_clock::now();
   auto elapsed = [&] {
     return wall_before +
@@ -192,13 +260,17 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
 
   write_checkpoint();
   auto last = std::chrono::steady_clock::now();
-  while (!optimizer.done()) {
-    optimizer.step();
-    const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
-      write_checkpoint();
-      last = now;
+  try {
+    while (!optimizer.done()) {
+      optimizer.step();
+      const auto now = std::chrono::steady_clock::now();
+      if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
+        write_checkpoint();
+        last = now;
+      }
     }
+  } catch (const ClusterError& e) {
+    rethrow_resumable(e, dir, saved_generation);
   }
   write_checkpoint();
   if (progress)
@@ -211,6 +283,7 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   outputs.render = render;
   outputs.ranks = cluster ? cluster->size() : 1;
   if (cluster) outputs.messages = messages_json(cluster->traffic());
+  if (const auto* timed = dynamic_cast<const TimedPoolEvaluator*>(batch)) outputs.rollouts = timed->to_json();
   write_run_outputs(outputs);
   if (sink) std::fprintf(sink, "results in %s (summary.json, motions/, filmstrip.png)\n",
                          dir.string().c_str());
@@ -255,8 +328,15 @@ void start_run(const RunRequest& request) {
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape, setup.bounds);
-  const auto batch = cluster_evaluator(request.cluster, setup, problem, pool);
-  DiversityOptimizer optimizer(problem, setup.options, pool, batch.get());
+  std::unique_ptr<BatchEvaluator> batch;
+  std::unique_ptr<DiversityOptimizer> started;
+  try {
+    batch = cluster_evaluator(request.cluster, setup, problem, pool);
+    started = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+  } catch (const ClusterError& e) {
+    rethrow_resumable(e, request.out, -1);
+  }
+  DiversityOptimizer& optimizer = *started;
   if (!request.quiet && optimizer.current_score().constraint[0] > 0) {
     // Most often a strength model: the input motion was found for the character at 1.
     char strength[32], c0[32];
@@ -273,7 +353,7 @@ void start_run(const RunRequest& request) {
                  setup.evaluator->task().m0.c_str());
   }
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
-        request.quiet, request.render, request.cluster);
+        request.quiet, request.render, request.cluster, batch.get());
 }
 
 void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpoint_seconds,
@@ -326,18 +406,30 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   std::unique_ptr<DiversityOptimizer> optimizer;
   if (fs::exists(dir / "checkpoint.json")) {
     const nlohmann::json state = read_run_checkpoint(dir / "checkpoint.json", setup.vary_shape, &wall_before);
-    if (cluster)
-      cluster->set_stop_message(stopped_line(dir, state.value("generation", -1LL)));
-    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
-    optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
-    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
+    const long long generation = state.value("generation", -1LL);
+    if (cluster) cluster->set_stop_message(stopped_line(dir, generation));
+    std::unique_ptr<BatchEvaluator> batch;
+    try {
+      batch = cluster_evaluator(cluster, setup, problem, pool);
+      optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
+    } catch (const ClusterError& e) {
+      rethrow_resumable(e, dir, generation);
+    }
+    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster,
+          batch.get());
   } else {
     // Stopped between writing run.json and its first checkpoint: run.json holds every
     // setting, so the run starts again from generation 0 (the same run, by determinism).
     if (cluster) cluster->set_stop_message(stopped_line(dir, -1));
-    const auto batch = cluster_evaluator(cluster, setup, problem, pool);
-    optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
-    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster);
+    std::unique_ptr<BatchEvaluator> batch;
+    try {
+      batch = cluster_evaluator(cluster, setup, problem, pool);
+      optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+    } catch (const ClusterError& e) {
+      rethrow_resumable(e, dir, -1);
+    }
+    drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster,
+          batch.get());
   }
 }
 

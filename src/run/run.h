@@ -26,7 +26,10 @@
 //
 // Results never depend on the thread count, the number of ranks or on interruptions: a run killed at any
 // moment and resumed from its checkpoint ends with the same summary.json as an
-// uninterrupted one, except for the "timing" object (wall time, threads).
+// uninterrupted one, except for the "timing" object (wall time, threads, ranks; under
+// mpirun "messages", the traffic between the ranks; in one process "rollouts", the CPU
+// time of every rollout this process ran, as deciles, and the sizes of the batches the
+// strategy asked for: what scripts/scaling-model.py reads).
 #pragma once
 
 #include <filesystem>

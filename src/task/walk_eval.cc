@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "control/walk_controller.h"
 
 namespace diverse {
@@ -95,6 +97,7 @@ void WalkObserver::close_state(int state) {
                              w * state_qpos_[hi * static_cast<size_t>(nq_) + static_cast<size_t>(i)]);
     }
     sample_state_.push_back(state);
+    sample_heading_.push_back(stride_heading_);
     sample_tau_.push_back(tau);
     sample_time_.push_back(t);
   }
@@ -151,6 +154,7 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
       walk.steps.push_back(step);
       tilt_ = 0;
       last_foot_ = {f[0], f[1]};
+      if (state == kLeftLift) stride_heading_ = raw;  // a stride begins
       const int taken = static_cast<int>(walk.steps.size());
       if (taken >= w.steps) {
         last_step = true;
@@ -167,6 +171,16 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
   if (recording_) {
     state_time_.push_back(t);
     state_qpos_.insert(state_qpos_.end(), d->qpos, d->qpos + m->nq);
+  }
+
+  // Flight: a walk always has a foot on the ground (a moment's lift while the weight
+  // passes from one foot to the other is allowed).
+  if (contacts_.foot[0] || contacts_.foot[1]) {
+    flight_start_ = -1;
+  } else if (flight_start_ < 0) {
+    flight_start_ = t;
+  } else if (t - flight_start_ > w.max_flight) {
+    return fall(d, "both feet were off the ground for longer than max_flight (a hop, not a walk)");
   }
 
   // Falls.
@@ -192,13 +206,18 @@ std::vector<PoseSample> WalkObserver::poses(SimWorker& worker) const {
     p.phase = sample_state_[k];
     p.phase_time = sample_tau_[k];
     p.time = sample_time_[k];
+    // In the stride's heading frame: the same gait walked in another direction gives the
+    // same poses (the metric aligns the translation itself).
+    const Eigen::Matrix3d to_heading =
+        Eigen::AngleAxisd(-sample_heading_[k], Eigen::Vector3d::UnitZ()).toRotationMatrix();
     p.link_com.resize(3, static_cast<int>(body_.links.size()));
     for (size_t i = 0; i < body_.links.size(); ++i) {
-      for (int c = 0; c < 3; ++c) p.link_com(c, static_cast<int>(i)) = d->xipos[3 * body_.links[i] + c];
+      const double* x = d->xipos + 3 * body_.links[i];
+      p.link_com.col(static_cast<int>(i)) = to_heading * Eigen::Vector3d(x[0], x[1], x[2]);
     }
     p.angles.resize(static_cast<int>(body_.joints.size()));
     for (size_t i = 0; i < body_.joints.size(); ++i) p.angles[static_cast<int>(i)] = d->qpos[body_.joints[i].qpos];
-    p.root = root_orientation(body_, d->qpos);
+    p.root = Eigen::Quaterniond(to_heading) * root_orientation(body_, d->qpos);
     out.push_back(std::move(p));
   }
   return out;

@@ -9,7 +9,11 @@
 // lift, right strike) each state gives `samples` poses at its state-normalized times
 // (k + 0.5) / samples, interpolated between the bracketing simulation steps:
 // 4 * samples * (steps - settle_steps) / 2 poses for a walk that takes all its steps, none
-// otherwise. PoseSample::phase is the state (0 to 3).
+// otherwise. PoseSample::phase is the state (0 to 3). The poses are in the stride's heading
+// frame: link positions and the root orientation are turned about the vertical by minus
+// the root's heading (from standing) at the touch-down that began the stride, so a gait
+// walked in another direction gives the same poses, while the root's sway within a stride
+// stays in them.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -61,6 +65,7 @@ class WalkObserver : public StepHooks {
   double heading_ = 0, last_raw_heading_ = 0;  // unwrapped
   std::array<double, 2> last_foot_{};   // where the previous stance foot is (m, x y)
   double tilt_ = 0;                     // rad, largest since the last step
+  double flight_start_ = -1;            // s, when both feet last left the ground; -1 if one is down
   int nq_ = 0;
   // Recording the evaluated strides.
   bool recording_ = false;
@@ -69,6 +74,8 @@ class WalkObserver : public StepHooks {
   std::vector<double> state_time_, state_qpos_;   // the current state's steps
   std::vector<int> sample_state_;                  // per sample: its state
   std::vector<double> sample_tau_, sample_time_, sample_qpos_;
+  std::vector<double> sample_heading_;             // per sample: its stride's heading (rad)
+  double stride_heading_ = 0;                      // rad, at the touch-down that began the stride
 };
 
 }  // namespace diverse

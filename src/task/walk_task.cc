@@ -25,7 +25,7 @@ void read_range(const TomlReader& r, const char* key, double lo, double hi, doub
 }  // namespace
 
 void read_walk(const TomlReader& r, TaskWalk& w) {
-  r.only({"steps", "settle_steps", "forward", "lateral", "max_tilt", "max_turn", "max_time"});
+  r.only({"steps", "settle_steps", "forward", "lateral", "max_tilt", "max_turn", "max_flight", "max_time"});
   w.enabled = true;
   w.steps = static_cast<int>(r.integer("steps", 1, 1000, w.steps));
   w.settle_steps = static_cast<int>(r.integer("settle_steps", 0, w.steps - 1, std::min(w.settle_steps, w.steps - 1)));
@@ -33,7 +33,14 @@ void read_walk(const TomlReader& r, TaskWalk& w) {
   read_range(r, "lateral", -5, 5, w.lateral_center, w.lateral_half_width);
   w.max_tilt_deg = r.number("max_tilt", 0, 90, w.max_tilt_deg);
   w.max_turn_deg = r.number("max_turn", 0, 360, w.max_turn_deg);
+  w.max_flight = r.number("max_flight", 0, 10, w.max_flight);
   w.max_time = r.number("max_time", 1, 600, w.max_time);
+}
+
+double largest_turn(const WalkSummary& walk) {
+  double turn = 0;
+  for (const WalkStep& s : walk.steps) turn = std::max(turn, std::fabs(s.heading - walk.start_heading));
+  return turn;
 }
 
 ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion) {
@@ -64,11 +71,7 @@ ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion)
     lateral += l * l;
     tilt += t * t;
   }
-  double turn = 0;
-  if (steps.size() > static_cast<size_t>(w.settle_steps)) {
-    const double from = w.settle_steps > 0 ? steps[static_cast<size_t>(w.settle_steps) - 1].heading : motion.walk.start_heading;
-    turn = std::max(0.0, std::fabs(steps.back().heading - from) - w.max_turn_deg * kDeg);
-  }
+  const double turn = std::max(0.0, largest_turn(motion.walk) - w.max_turn_deg * kDeg);
   add("step_forward", std::sqrt(forward), c.weight * forward);
   add("step_lateral", std::sqrt(lateral), c.weight * lateral);
   add("upright", std::sqrt(tilt), c.weight * tilt);
@@ -87,8 +90,7 @@ double walk_margin(const Task& task, const MotionSummary& motion) {
                        w.lateral_half_width - std::fabs(s.lateral - w.lateral_center),
                        w.max_tilt_deg * kDeg - s.tilt});
   }
-  const double from = w.settle_steps > 0 ? steps[static_cast<size_t>(w.settle_steps) - 1].heading : motion.walk.start_heading;
-  margin = std::min(margin, w.max_turn_deg * kDeg - std::fabs(steps.back().heading - from));
+  margin = std::min(margin, w.max_turn_deg * kDeg - largest_turn(motion.walk));
   return std::isfinite(margin) ? margin : -1;
 }
 

@@ -10,7 +10,8 @@
 //   forward = { center = 1.0, half_width = 0.5 }   # m, every evaluated step
 //   lateral = { center = 0.0, half_width = 0.5 }   # m, every evaluated step
 //   max_tilt = 15.0             # degrees from vertical, pelvis and torso, evaluated steps
-//   max_turn = 30.0             # degrees, heading change over the evaluated steps
+//   max_turn = 30.0             # degrees, heading change from the start, every touch-down
+//   max_flight = 0.05           # s, longest time both feet may be off the ground at once
 //   max_time = 40.0             # s; a walk that has not taken `steps` steps by then fell
 //
 // A step is a touch-down of the swing foot that ends a strike state (the controller's
@@ -22,15 +23,17 @@
 //
 // Drift and turns. Step lengths are measured in the walker's own heading frame, so a
 // walk that curves gently is judged by its steps, not by where it heads; a walk that
-// sidles steps sideways, which the lateral range catches. The heading may change by at
-// most max_turn degrees between the touch-down that begins the evaluated steps and the
-// last one; beyond that the walk is turning, not walking, and pays K_c d^2 with d the
-// excess in rad.
+// sidles steps sideways, which the lateral range catches. At every touch-down of the walk,
+// the settling steps included, the heading must be within max_turn degrees of the
+// heading at the start; beyond that the walk is turning, not walking (a walk that turns
+// round in its first steps and then goes straight is another task), and pays K_c d^2
+// with d the largest excess in rad.
 //
 // C for a walk: K_c |d|^2 over every evaluated step's forward and lateral excess (m),
 // every pelvis/torso tilt excess (rad, the largest over each evaluated step) and the
 // turn excess (rad); a fall (a body other than the feet touching anything, the COM
-// within fall_com_height of the feet, a strike state that ends without a touch-down, not
+// within fall_com_height of the feet, a strike state that ends without a touch-down, both
+// feet off the ground for longer than max_flight (a hop: a walk has no flight phase), not
 // reaching `steps` steps within max_time) costs fall_penalty * (1 - k / steps) with k the
 // steps taken before it: fall_penalty for a fall in the first step, falling linearly to 0
 // after the last. A rollout whose simulation blew up costs 3 * fall_penalty.
@@ -54,6 +57,7 @@ struct TaskWalk {
   double lateral_center = 0.0, lateral_half_width = 0.5;  // m
   double max_tilt_deg = 15;
   double max_turn_deg = 30;
+  double max_flight = 0.05;  // s, both feet off the ground at once
   double max_time = 40;  // s
 };
 
@@ -74,6 +78,9 @@ struct WalkSummary {
   std::vector<WalkStep> steps;
   double start_heading = 0;  // rad
 };
+
+// The largest |heading - start heading| over the walk's touch-downs (rad).
+double largest_turn(const WalkSummary& walk);
 
 // The walk terms of C (called by evaluate_constraints() for a walk task).
 ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion);

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end test of `diverse gallery` and `diverse export --bvh --gltf` in headless
-# Chromium: makes a short real run (the planar human's high jump), a run of 3D motions
+# Chromium: makes a short real run (the planar human's high jump) with 12 blends, a run of 3D motions
 # (the 3D human pushed three ways under stance control, tests/support/stance_run.h) and a
 # 3D walk that the views follow, their gallery pages, BVH and glTF files, then runs
 # web/test/gallery.e2e.mjs on each (no network: the page must work from disk).
@@ -39,6 +39,7 @@ fi
 # Short but real: 2 variations, 3 generations of 8 samples, within bounds the page shows.
 "$diverse" run "$src/tasks/jump_high.toml" --n 2 --generations 3 --popsize 8 --sigma0 0.03 --seed 5 \
   --effort-bound 3 --max-distance 1000 --quiet --no-render --out "$work/run"
+"$diverse" blend "$work/run" --samples 12 --path-points 4
 "$diverse" gallery "$work/run"
 "$diverse" export "$work/run" --bvh --gltf
 CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/run"

@@ -141,12 +141,14 @@ TEST(DiversityOptions, StrategyNames) {
   EXPECT_EQ(parse_strategy("round-robin"), DiversityStrategy::kRoundRobin);
   EXPECT_EQ(parse_strategy("progressive"), DiversityStrategy::kProgressive);
   EXPECT_EQ(parse_strategy("joint"), DiversityStrategy::kJoint);
+  EXPECT_EQ(parse_strategy("simultaneous"), DiversityStrategy::kSimultaneous);
   try {
     parse_strategy("greedy", "--strategy");
     FAIL();
   } catch (const UserError& e) {
     EXPECT_STREQ(e.what(),
-                 "--strategy: expected one of round-robin, progressive, joint, got 'greedy'");
+                 "--strategy: expected one of round-robin, progressive, joint, simultaneous, got "
+                 "'greedy'");
   }
 }
 
@@ -200,8 +202,9 @@ TEST(DiversityOptions, ValidationAndJsonRoundTrip) {
 }
 
 // Parameterized suites run once per strategy, named after it ("roundrobin", ...).
-const auto kAllStrategies = ::testing::Values(
-    DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive, DiversityStrategy::kJoint);
+const auto kAllStrategies =
+    ::testing::Values(DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive,
+                      DiversityStrategy::kJoint, DiversityStrategy::kSimultaneous);
 std::string strategy_test_name(const ::testing::TestParamInfo<DiversityStrategy>& info) {
   std::string name = to_string(info.param);
   name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
@@ -440,6 +443,74 @@ TEST(DiversityJoint, OneInstanceOverAllVariations) {
   EXPECT_GT(opt.result().score.D, 0.0);
 }
 
+// Records the size of every batch the optimizer asks for, evaluating on one thread.
+class CountingBatch : public BatchEvaluator {
+ public:
+  explicit CountingBatch(const DiversityProblem& problem) : problem_(problem) {}
+  std::vector<std::shared_ptr<const Outcome>> evaluate(const std::vector<Eigen::VectorXd>& xs) override {
+    sizes.push_back(xs.size());
+    std::vector<std::shared_ptr<const Outcome>> out;
+    for (const auto& x : xs) out.push_back(problem_.evaluate(x, 0));
+    return out;
+  }
+  std::vector<std::size_t> sizes;
+
+ private:
+  const DiversityProblem& problem_;
+};
+
+TEST(DiversitySimultaneous, EveryVariationsGenerationInOneBatch) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  for (VariationPoint point : {VariationPoint::kBestSample, VariationPoint::kMean}) {
+    SCOPED_TRACE(to_string(point));
+    DiversityOptions o = small_options(DiversityStrategy::kSimultaneous, 5);
+    o.point = point;
+    CountingBatch batch(problem);
+    DiversityOptimizer opt(problem, o, pool, &batch);
+    opt.run();
+    // M_0, then per generation one batch of N x lambda (and, standing at means, the N
+    // new means in one more).
+    std::vector<std::size_t> expected{1};
+    for (int g = 0; g < 5; ++g) {
+      expected.push_back(3 * 16);
+      if (point == VariationPoint::kMean) expected.push_back(3);
+    }
+    EXPECT_EQ(batch.sizes, expected);
+    EXPECT_EQ(opt.evaluations(), 1 + 5 * (3 * 16 + (point == VariationPoint::kMean ? 3 : 0)));
+    ASSERT_EQ(opt.log().size(), 5u);
+    for (const auto& r : opt.log()) EXPECT_EQ(r.variation, 0);
+    EXPECT_GT(opt.result().score.D, 0.0);
+  }
+  // The same budget as round-robin, whose batches hold one variation's lambda.
+  CountingBatch round_robin(problem);
+  DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 5);
+  o.point = VariationPoint::kBestSample;
+  DiversityOptimizer rr(problem, o, pool, &round_robin);
+  rr.run();
+  EXPECT_EQ(round_robin.sizes.size(), 1u + 5 * 3);
+  EXPECT_EQ(round_robin.sizes.back(), 16u);
+  EXPECT_EQ(rr.evaluations(), 1 + 5 * 3 * 16);
+}
+
+// Variation 1's first generation is the same in both strategies (the same CMA stream,
+// scored against the same starting set); variation 2's differs, since in round-robin its
+// samples see where variation 1 moved, in simultaneous they do not.
+TEST(DiversitySimultaneous, SamplesAreScoredAgainstTheSetAsTheGenerationWasDrawn) {
+  const BallProblem problem(2, 0.3);
+  ThreadPool pool(1);
+  DiversityOptions o = small_options(DiversityStrategy::kSimultaneous, 1);
+  o.point = VariationPoint::kBestSample;
+  DiversityOptimizer simultaneous(problem, o, pool);
+  simultaneous.run();
+  o.strategy = DiversityStrategy::kRoundRobin;
+  DiversityOptimizer round_robin(problem, o, pool);
+  round_robin.step();
+  const nlohmann::json a = simultaneous.checkpoint()["cma"], b = round_robin.checkpoint()["cma"];
+  EXPECT_EQ(a[0], b[0]);
+  EXPECT_NE(a[1], b[1]);
+}
+
 TEST(DiversityTermination, StagnationWindow) {
   const BallProblem problem(2, 0.3);
   ThreadPool pool(1);
@@ -467,7 +538,7 @@ TEST(DiversityFailures, BlownUpSamplesNeverMakeDNonFinite) {
   const BallProblem problem(2, 0.3, 0.55);
   ThreadPool pool(2);
   for (DiversityStrategy s : {DiversityStrategy::kRoundRobin, DiversityStrategy::kProgressive,
-                              DiversityStrategy::kJoint}) {
+                              DiversityStrategy::kJoint, DiversityStrategy::kSimultaneous}) {
     DiversityOptions o = small_options(s, 30);
     o.sigma0 = 0.2;
     DiversityOptimizer opt(problem, o, pool);

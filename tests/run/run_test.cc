@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -69,6 +70,34 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
   EXPECT_TRUE(sa["all_satisfied"].get<bool>());
   for (int i = 0; i <= 2; ++i) EXPECT_EQ(sa["motions"][i]["constraint"], 0.0) << i;
   for (int i = 1; i <= 2; ++i) EXPECT_GT(sa["distances"]["md"][0][i].get<double>(), 0.0) << i;
+}
+
+// summary.json's timing.rollouts: every rollout of the run (M0 once, then N x lambda per
+// generation) with its CPU time, and the batches the strategy asked for: round-robin one
+// per variation and generation, simultaneous one per generation.
+TEST(Run, TimingHoldsTheRolloutsAndTheStrategysBatches) {
+  struct Case {
+    const char* strategy;
+    long long batches, largest;
+  };
+  for (const Case& c : {Case{"round-robin", 1 + 5 * 2, 8}, Case{"simultaneous", 1 + 5, 2 * 8}}) {
+    SCOPED_TRACE(c.strategy);
+    const fs::path dir = scratch(std::string("timing_") + c.strategy);
+    Result r = run_cli("run " + kShort + " --threads 2 --strategy " + c.strategy + " --out " + dir.string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const auto s = read_json(dir / "summary.json");
+    EXPECT_EQ(s["evaluations"], 1 + 5 * 2 * 8);
+    const auto& rollouts = s["timing"]["rollouts"];
+    EXPECT_EQ(rollouts["count"], 1 + 5 * 2 * 8);
+    EXPECT_EQ(rollouts["batches"], c.batches);
+    EXPECT_EQ(rollouts["batch_size"]["max"], c.largest);
+    EXPECT_EQ(rollouts["batch_size"]["min"], 1);  // M0
+    const auto deciles = rollouts["cpu_ms"]["deciles"].get<std::vector<double>>();
+    ASSERT_EQ(deciles.size(), 11u);
+    EXPECT_GT(deciles.front(), 0.0);
+    EXPECT_TRUE(std::is_sorted(deciles.begin(), deciles.end()));
+    EXPECT_TRUE(s["all_satisfied"].get<bool>());
+  }
 }
 
 TEST(Run, ResumeAfterKillGivesTheSameSummary) {

@@ -1,9 +1,9 @@
 // Walk tasks (task/walk_task.h, task/walk_eval.h): the [walk] table is read strictly and
 // must go with a walk controller; the walk constraint penalty follows the task's ranges,
-// grades a fall by the steps taken and judges turns; evaluating the committed starting
-// walks counts 30 alternating steps and stops at the last touch-down, meets both tasks,
-// and gives 10 pose samples in each of the 4 states of the 10 evaluated strides; a walk
-// that falls ends its rollout at the fall.
+// grades a fall by the steps taken and judges turns from the start's heading; evaluating
+// the committed input walks counts 30 alternating steps and stops at the last touch-down,
+// meets both tasks, and gives 10 pose samples in each of the 4 states of the 10 evaluated
+// strides, in each stride's heading frame; a hop and a fall end the rollout.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -87,6 +87,8 @@ TEST(WalkTaskFile, BadInputIsOneLine) {
                ": walk.strides: expected no such key");
   EXPECT_EQ(error_of(replace(walk_text(), "settle_steps = 10", "settle_steps = 30")),
             ": walk.settle_steps: expected an integer in [0, 29], got 30");
+  EXPECT_PRED2(starts, error_of(replace(walk_text(), "settle_steps = 10\n", "settle_steps = 10\nmax_flight = -0.1\n")),
+               ": walk.max_flight: expected a number in [0, 10]");
   EXPECT_PRED2(starts, error_of(replace(walk_text(), "half_width = 0.5 }", "half = 0.5 }")),
                ": walk.forward.half: expected no such key");
   EXPECT_EQ(error_of(replace(walk_text(), "[walk]\nsteps = 30\nsettle_steps = 10\nforward = { center = 1.0, half_width = 0.5 }\n", "")),
@@ -126,6 +128,12 @@ TEST(WalkConstraints, RangesFallsAndTurns) {
   // Turning 40 degrees over the evaluated steps: 10 over.
   const double turn = 10 * M_PI / 180;
   EXPECT_NEAR(evaluate_constraints(task, walk_of(30, 1.0, 0.2, 5, 40 * M_PI / 180)).total, K * turn * turn, 1e-6);
+  // Turning round 90 degrees while settling, then walking straight: 60 over, although the
+  // evaluated steps do not turn.
+  MotionSummary round = walk_of(30, 1.0, 0.2, 5, 0);
+  for (size_t i = 0; i < round.walk.steps.size(); ++i) round.walk.steps[i].heading = i >= 5 ? M_PI / 2 : 0;
+  const double round_over = 60 * M_PI / 180;
+  EXPECT_NEAR(evaluate_constraints(task, round).total, K * round_over * round_over, 1e-6);
   // Falls: 50,000 in the first step, linearly to 0 after the 30th.
   for (const int taken : {0, 15, 29}) {
     MotionSummary s = walk_of(taken, 1.0, 0.2, 5, 0);
@@ -140,9 +148,11 @@ TEST(WalkConstraints, RangesFallsAndTurns) {
   EXPECT_EQ(evaluate_constraints(task, blew_up).total, 150000);
 }
 
+// The committed input walks. (The human's hand-authored start, silly_walk_start.json, hops
+// in its third step: both feet off the ground for longer than max_flight.)
 void expect_meets(const std::string& name) {
   const TaskEvaluator ev(load_task(kTasks + name + ".toml"));
-  const ParameterSet p = ev.load_parameters(ev.task().seed.base);
+  const ParameterSet p = ev.load_parameters(ev.task().m0);
   const auto worker = ev.make_worker();
   const Evaluation e = ev.evaluate(p.values(), *worker);
   ASSERT_FALSE(e.failed) << e.failure;
@@ -172,8 +182,54 @@ void expect_meets(const std::string& name) {
   EXPECT_EQ(again.poses.back().link_com, e.poses.back().link_com);
 }
 
-TEST(WalkEvaluation, HumanStartMeetsTheTask) { expect_meets("silly_walk"); }
-TEST(WalkEvaluation, RobotStartMeetsTheTask) { expect_meets("robot_silly_walk"); }
+TEST(WalkEvaluation, HumanInputWalkMeetsTheTask) { expect_meets("silly_walk"); }
+TEST(WalkEvaluation, RobotInputWalkMeetsTheTask) { expect_meets("robot_silly_walk"); }
+
+// A walk's pose samples are in its stride's heading frame, so the metrics see its gait,
+// not the direction it walks in. The bird robot of tests/task/data/robot_walk_turns_round.json
+// turns about 140 degrees right during its settling steps and then walks straight: in
+// world axes its root faces far from the start direction in every evaluated stride, in
+// the poses it faces ahead, give or take its sway within a stride.
+TEST(WalkEvaluation, PosesAreInTheStridesHeadingFrame) {
+  Task task = load_task(kTasks + "robot_silly_walk.toml");
+  task.walk.max_flight = 10;  // it hops at its start (WalkEvaluation.AHopIsAFall)
+  const TaskEvaluator ev(task);
+  const ParameterSet p =
+      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/robot_walk_turns_round.json");
+  const auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(p.values(), *worker);
+  ASSERT_FALSE(e.fell) << e.summary.fall_reason;
+  const auto& steps = e.summary.walk.steps;
+  ASSERT_EQ(steps.size(), 30u);
+  EXPECT_LT(steps[9].heading, -100 * M_PI / 180);  // turned round while settling
+  // It breaks the task's turn rule (30 degrees from the start, at every touch-down).
+  EXPECT_GT(e.report.total, 0);
+  ASSERT_EQ(e.poses.size(), 400u);
+  // The yaw of the root's standing forward axis, in world axes and in the pose samples.
+  auto yaw = [](const Eigen::Quaterniond& root, const Eigen::Quaterniond& standing) {
+    const Eigen::Vector3d forward = root * (standing.inverse() * Eigen::Vector3d::UnitX());
+    return std::atan2(forward.y(), forward.x());
+  };
+  const Eigen::Quaterniond standing = root_orientation(ev.body(), ev.model().get()->qpos0);
+  double worst = 0;
+  for (const PoseSample& s : e.poses) worst = std::max(worst, std::fabs(yaw(s.root, standing)));
+  EXPECT_LT(worst, 30 * M_PI / 180);
+}
+
+// Both feet off the ground for longer than max_flight is a hop, not a walk: the same
+// robot pushes off into a hop while its swing foot is up in its first step.
+TEST(WalkEvaluation, AHopIsAFall) {
+  const TaskEvaluator ev(load_task(kTasks + "robot_silly_walk.toml"));
+  ASSERT_EQ(ev.task().walk.max_flight, 0.05);
+  const ParameterSet p =
+      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/robot_walk_turns_round.json");
+  const auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(p.values(), *worker);
+  ASSERT_TRUE(e.fell);
+  EXPECT_EQ(e.summary.fall_reason, "both feet were off the ground for longer than max_flight (a hop, not a walk)");
+  EXPECT_LT(e.summary.walk.steps.size(), 2u);
+  EXPECT_NEAR(e.report.terms.front().penalty, 50000.0 * (1 - e.summary.walk.steps.size() / 30.0), 1e-6);
+}
 
 TEST(WalkEvaluation, FallEndsTheRollout) {
   const TaskEvaluator ev(load_task(kTasks + "silly_walk.toml"));

@@ -276,8 +276,8 @@ TEST(ToyCli, BadArgumentsGiveOneLineErrors) {
       {"toy --generations 0" + out,
        "diverse: error: --generations: expected an integer in [1, 1000000], got '0'\n"},
       {"toy --strategy greedy" + out,
-       "diverse: error: --strategy: expected one of round-robin, progressive, joint, got "
-       "'greedy'\n"},
+       "diverse: error: --strategy: expected one of round-robin, progressive, joint, simultaneous, "
+       "got 'greedy'\n"},
       {"toy --out " + (file / "sub").string(),
        "diverse: error: " + (file / "sub").string() +
            ": cannot create output directory (Not a directory)\n"},

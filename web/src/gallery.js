@@ -190,7 +190,25 @@ const tiles = data.motions.map((m, i) => {
     pathIndex: path ? path.points.length - 1 : -1,
   };
 });
-const shownTrack = (tile) => (tile.pathIndex >= 0 && tile.path ? tile.pathTracks[tile.pathIndex] : tile.main);
+// The blends of the run's motions (`diverse blend`), when the page has them: one more tile
+// plays the precomputed blend nearest to the weights picked in the blend panel.
+const blend = data.blend && data.blend.points && data.blend.points.length ? data.blend : null;
+if (blend) {
+  const blendTracks = blend.points.map((p) => makeTrack(p, p.label));
+  tiles.push({
+    index: tiles.length,
+    motion: { label: 'Blend' },
+    blend,
+    blendTracks,
+    blendIndex: 0,
+    main: blendTracks[0],
+    path: null,
+    pathTracks: [],
+    pathIndex: -1,
+  });
+}
+const shownTrack = (tile) => (tile.blend ? tile.blendTracks[tile.blendIndex]
+  : tile.pathIndex >= 0 && tile.path ? tile.pathTracks[tile.pathIndex] : tile.main);
 const duration = () => Math.max(1e-6, ...tiles.map((t) => shownTrack(t).duration));
 
 // ---------------------------------------------------------------- three.js scene
@@ -294,10 +312,11 @@ function relativeExtent(tracks) {
 }
 const view = data.view || { three_quarter: false, follow: false };
 const floorZ = data.models.find((m) => m.floor !== null)?.floor ?? 0;
-const bounds = extent(tiles.flatMap((t) => [t.main, ...t.pathTracks]));
-const globalViewBounds = extent(tiles.map((t) => t.main));
+const motionTiles = tiles.filter((t) => !t.blend);
+const bounds = extent(tiles.flatMap((t) => [t.main, ...t.pathTracks, ...(t.blendTracks || [])]));
+const globalViewBounds = extent(motionTiles.map((t) => t.main));
 const viewBounds = globalViewBounds;
-const followBounds = relativeExtent(tiles.map((t) => t.main));
+const followBounds = relativeExtent(motionTiles.map((t) => t.main));
 followBounds.min.z = Math.min(followBounds.min.z, floorZ);
 for (const box of [bounds, viewBounds]) {
   box.min.z = Math.min(box.min.z, floorZ);
@@ -447,7 +466,7 @@ function pose(r, track, t) {
 
 for (const t of tiles) {
   rig(t.main.model);
-  for (const p of t.pathTracks) rig(p.model);
+  for (const p of [...t.pathTracks, ...(t.blendTracks || [])]) rig(p.model);
   if (t.path) rig(t.main.model, true);
 }
 
@@ -522,6 +541,16 @@ function statusOf(c, failed, fell) {
 }
 
 function updateTileText(t) {
+  if (t.blend) {
+    const b = t.blend.points[t.blendIndex];
+    const s = statusOf(b.constraint, b.failed, b.fell);
+    t.status.textContent = s.text;
+    t.status.className = `status ${s.ok ? 'ok' : 'bad'}`;
+    t.dom.classList.toggle('infeasible', !s.ok);
+    t.caption.replaceChildren();
+    t.caption.append(`${b.label} = ${blendFormula(b.weights)}`);
+    return;
+  }
   const point = t.path && t.pathIndex >= 0 ? t.path.points[t.pathIndex] : null;
   const s = point && !point.result
     ? statusOf(point.constraint, point.failed, false)
@@ -545,7 +574,11 @@ for (const t of tiles) {
   head.append(el('span', { class: 'label' }, t.motion.label), t.status);
   const viewport = el('div', { class: 'viewport', 'aria-label': `${t.motion.label} in 3D` });
   const foot = el('div', { class: 'tile-foot' });
-  if (t.path && t.path.points.length) {
+  if (t.blend) {
+    dom.classList.add('blend');
+    t.caption = el('div', { class: 'blend-caption' });
+    foot.append(el('div', { class: 'path-title' }, 'The precomputed blend nearest to the weights picked below'), t.caption);
+  } else if (t.path && t.path.points.length) {
     const title = el('div', { class: 'path-title' });
     title.append(el('span', {}, 'Optimization path'),
       el('span', {}, `${t.path.points_total} points${t.path.by_index ? ', by step' : ''}`));
@@ -583,6 +616,87 @@ for (const t of tiles) {
   c.enableDamping = false;
   c.addEventListener('change', requestRender);
   controls.push(c);
+}
+
+// ---------------------------------------------------------------- blends
+
+// "0.50 M1 + 0.30 M2 + ...": the weights of a blend, largest first, those under 0.005 left out.
+function blendFormula(weights) {
+  const labels = data.motions.map((m) => m.label);
+  return weights.map((w, i) => [w, labels[i]]).filter(([w]) => w >= 0.005).sort((a, b) => b[0] - a[0])
+    .map(([w, l]) => `${w.toFixed(2)} ${l}`).join(' + ');
+}
+
+// The blend whose weights are nearest (Euclidean) to `weights`; ties go to the first.
+function nearestBlend(weights) {
+  let best = 0;
+  let bestD = Infinity;
+  blend.points.forEach((p, k) => {
+    let d = 0;
+    for (let i = 0; i < weights.length; ++i) d += (p.weights[i] - weights[i]) ** 2;
+    if (d < bestD) { bestD = d; best = k; }
+  });
+  return { index: best, distance: Math.sqrt(bestD) };
+}
+
+function fillBlends() {
+  const panel = $('blend-panel');
+  if (!blend) { panel.hidden = true; return; }
+  panel.hidden = false;
+  const tile = tiles.find((t) => t.blend);
+  const pct = (x) => (x === null || x === undefined ? 'n/a' : `${(100 * x).toFixed(0)} %`);
+  const n = data.motions.length;
+  let text = `${blend.points.length} blends of M0..M${n - 1}, each the controller at a convex combination of ` +
+    `theirs${data.shape ? ' (and a blend of their bodies)' : ''}, weights drawn uniformly: ` +
+    `${blend.feasible} meet the task (${pct(blend.feasible_fraction)}).`;
+  if (blend.path_points > 0) {
+    text += ` Points along the optimization paths, simulated the same way: ${pct(blend.path_feasible_fraction)} of ${blend.path_points}.`;
+  }
+  $('blend-summary').textContent = text;
+  const sliders = [];
+  const values = [];
+  const weights = () => {
+    const raw = sliders.map((s) => Number(s.value));
+    const sum = raw.reduce((a, b) => a + b, 0);
+    return sum > 0 ? raw.map((v) => v / sum) : raw.map(() => 1 / raw.length);
+  };
+  const update = () => {
+    const w = weights();
+    w.forEach((x, i) => { values[i].textContent = x.toFixed(2); });
+    const near = nearestBlend(w);
+    tile.blendIndex = near.index;
+    const b = blend.points[near.index];
+    const result = $('blend-result');
+    result.replaceChildren();
+    result.append(`Playing ${b.label}, ${fmt(near.distance)} from the picked weights: ${blendFormula(b.weights)}; `);
+    const ok = b.feasible;
+    result.append(el('span', { class: ok ? 'ok' : 'bad' },
+      ok ? 'meets the task' : `misses the task (C = ${fmt(b.constraint)})`));
+    if (b.nearest !== null && b.nearest !== undefined && Array.isArray(b.distances)) {
+      result.append(`; nearest motion ${data.motions[b.nearest].label} (d = ${fmt(b.distances[b.nearest])}, ` +
+        `${(data.metric || '').toUpperCase()}).`);
+    } else {
+      result.append('.');
+    }
+    result.dataset.blend = b.label;
+    updateTileText(tile);
+    syncScrubber();
+    requestRender();
+  };
+  const grid = $('blend-weights');
+  data.motions.forEach((m, i) => {
+    const row = el('label', { class: 'weight' });
+    const slider = el('input', { type: 'range', min: '0', max: '100', step: '1', value: '50',
+      'aria-label': `weight of ${m.label}`, 'data-motion': m.label });
+    const value = el('span', { class: 'weight-value' });
+    slider.addEventListener('input', update);
+    row.append(el('span', { class: 'weight-label' }, m.label), slider, value);
+    grid.append(row);
+    sliders.push(slider);
+    values.push(value);
+  });
+  $('blend-equal').addEventListener('click', () => { for (const s of sliders) s.value = '50'; update(); });
+  update();
 }
 
 // ---------------------------------------------------------------- playback
@@ -701,6 +815,7 @@ function frame(now) {
 
 fillHeader();
 fillDistances();
+fillBlends();
 fillPlots(data, $);
 $('play').textContent = playing ? 'Pause' : 'Play';
 new ResizeObserver(requestRender).observe($('stage'));

@@ -16,7 +16,10 @@
 // passes the Khronos glTF validator with no error, three.js's GLTFLoader reads each with a
 // node per body and its animation, and playing it puts every body within 1 mm of MuJoCo's
 // positions; all.glb is drawn in Chromium by a small three.js viewer (its pixels are not
-// uniform). Writes RUN_DIR/gallery-screenshot.png, plots-screenshot.png and
+// uniform). With blends (`diverse blend`): one blend tile and one weight slider per motion;
+// for every blend, its own weights on the sliders bring up the blend nearest to them (as
+// the test computes it), marked as meeting the task or not as its constraint says; two
+// corners of the simplex show different pictures. Writes RUN_DIR/gallery-screenshot.png, plots-screenshot.png and
 // gltf-screenshot.png. Chromium: $CHROMIUM or /usr/bin/chromium.
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -98,8 +101,10 @@ try {
   check(labels[0] === 'Pause' && labels[1] === 'Play', 'the play/pause button plays and pauses', labels.join(', '));
 
   const data = await page.evaluate(() => JSON.parse(document.getElementById('gallery-data').textContent));
-  check(await page.locator('.tile').count() === data.motions.length, 'one tile per motion',
-    `${await page.locator('.tile').count()} tiles, ${data.motions.length} motions`);
+  check(await page.locator('.tile:not(.blend)').count() === data.motions.length, 'one tile per motion',
+    `${await page.locator('.tile:not(.blend)').count()} tiles, ${data.motions.length} motions`);
+  check(await page.locator('.tile.blend').count() === (data.blend ? 1 : 0),
+    data.blend ? 'one tile plays the blends' : 'no blend tile without blends');
 
   // Two animation frames, so what was asked for is on the canvas.
   const settle = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
@@ -166,6 +171,83 @@ try {
     }
     check(marks === points.length, 'infeasible path points are marked (C > 0)', `${marks} of ${points.length}`);
     await slider.fill(String(points.length - 1));
+  }
+
+  // ---------------------------------------------------------------- blends
+
+  if (data.blend) {
+    const blends = data.blend.points;
+    const n = data.motions.length;
+    const sliders = page.locator('#blend-weights input[type=range]');
+    check(await sliders.count() === n, 'the blend panel has one weight slider per motion', `${await sliders.count()} sliders`);
+    check(blends.every((b) => b.weights.length === n && Math.abs(b.weights.reduce((a, x) => a + x, 0) - 1) < 1e-9),
+      'every blend has one weight per motion, summing to 1');
+    const summary = await page.textContent('#blend-summary');
+    check(summary.includes(`${blends.length} blends`) && summary.includes(`${data.blend.feasible} meet the task`),
+      'the blend panel says how many blends meet the task', summary);
+    // The same rule as the page: slider values scaled to sum 1, the nearest blend's weights.
+    const expectedNearest = (values) => {
+      const sum = values.reduce((a, x) => a + x, 0);
+      const w = values.map((x) => (sum > 0 ? x / sum : 1 / n));
+      let best = 0;
+      let bestD = Infinity;
+      blends.forEach((b, k) => {
+        const d = b.weights.reduce((a, x, i) => a + (x - w[i]) ** 2, 0);
+        if (d < bestD) { bestD = d; best = k; }
+      });
+      return best;
+    };
+    const blendTile = page.locator('.tile.blend');
+    // All sliders at once, then one input event (the page reads every slider on each).
+    const setWeights = (values) => page.evaluate((v) => {
+      const inputs = [...document.querySelectorAll('#blend-weights input[type=range]')];
+      inputs.forEach((s, i) => { s.value = String(v[i]); });
+      inputs[0].dispatchEvent(new Event('input', { bubbles: true }));
+    }, values);
+    // Each blend's own weights (as the sliders can hold them) bring up the blend the page
+    // should pick, marked as meeting the task or not as its constraint value says.
+    let right = 0;
+    const seen = new Set();
+    for (const b of blends) {
+      const values = b.weights.map((w) => Math.round(100 * w));
+      await setWeights(values);
+      const want = blends[expectedNearest(values)];
+      seen.add(want.label);
+      const shown = await page.locator('#blend-result').getAttribute('data-blend');
+      const infeasible = await blendTile.evaluate((e) => e.classList.contains('infeasible'));
+      const result = await page.textContent('#blend-result');
+      const status = await blendTile.locator('.status').textContent();
+      if (shown === want.label && infeasible === !want.feasible &&
+          result.includes(want.feasible ? 'meets the task' : 'misses the task') &&
+          status.includes(want.feasible ? 'meets the task' : want.failed ? 'failed' : want.fell ? 'fell' : 'misses the task')) right++;
+    }
+    check(right === blends.length, 'picking weights plays the nearest blend, marked as meeting the task or not',
+      `${right} of ${blends.length}`);
+    check(seen.size > 1, 'different weights bring up different blends', [...seen].join(' '));
+    // Weight on one motion alone, then on another: the blend view changes.
+    const corner = (i) => Array.from({ length: n }, (_, j) => (j === i ? 100 : 0));
+    const a = expectedNearest(corner(0));
+    const other = [...Array(n).keys()].find((i) => expectedNearest(corner(i)) !== a);
+    if (other !== undefined) {
+      // Through the sliders themselves, as a user moves them.
+      const fillWeights = async (values) => {
+        for (let i = 0; i < n; ++i) await sliders.nth(i).fill(String(values[i]));
+      };
+      await page.locator('#time').fill('600');
+      await fillWeights(corner(0));
+      await settle();
+      await snapshot();
+      await fillWeights(corner(other));
+      await settle();
+      const moved = await snapshot();
+      check(moved.changed > 300, 'moving the weights to another corner changes the blend\'s picture', `${moved.changed} pixels changed`);
+      const shownLabel = await page.locator('#blend-result').getAttribute('data-blend');
+      check(shownLabel === blends[expectedNearest(corner(other))].label, 'the sliders pick the blend nearest to their weights',
+        `${shownLabel}, expected ${blends[expectedNearest(corner(other))].label}`);
+    }
+    await page.locator('#blend-equal').click();
+  } else {
+    check(await page.locator('#blend-panel').isHidden(), 'a gallery without blends hides the blend panel');
   }
 
   // ---------------------------------------------------------------- 3D: the view
