@@ -17,6 +17,7 @@
 #include "metric/metric.h"
 #include "optimize/diversity.h"
 #include "run/run.h"
+#include "task/task.h"
 
 namespace diverse::cli {
 namespace {
@@ -56,6 +57,9 @@ struct RunArgs {
   bool quiet = false;
   bool no_render = false;
   double checkpoint_seconds = 5.0;
+  double strength = 1.0;
+  double effort_bound = 0.0;  // 0 = none
+  double max_distance = 0.0;  // 0 = none
   double rank_timeout = kDefaultRankTimeoutSeconds;
 };
 
@@ -115,6 +119,19 @@ void install_run(CLI::App& app) {
   cmd->add_option("--epsilon", args->epsilon, "See --window")
       ->capture_default_str()
       ->check(number_in(0, 1e12));
+  cmd->add_option("--strength", args->strength,
+                  "Strength model: every joint's PD gains and torque limits times S (paper: "
+                  "1.5 to 3 for a 'supernatural' character); saved models carry the limits")
+      ->capture_default_str()
+      ->check(number_in(kMinStrength, kMaxStrength));
+  cmd->add_option("--effort-bound", args->effort_bound,
+                  "Keep every variation's control effort (time integral of the squared net "
+                  "joint torques) within R times the input motion's, R >= 1 (default: no bound)")
+      ->check(number_in(kMinEffortBound, kMaxEffortBound));
+  cmd->add_option("--max-distance", args->max_distance,
+                  "Keep every variation within X of the input motion in the run's metric, X > 0 "
+                  "(default: no bound)")
+      ->check(number_in(0, kMaxDistanceBound, Bound::kOpen));
   cmd->add_option("--out", args->out, "Run directory (default: runs/<task>)");
   cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
   cmd->add_flag("--quiet", args->quiet, "No progress output");
@@ -152,6 +169,9 @@ void install_run(CLI::App& app) {
     request.quiet = a.quiet;
     request.render = !a.no_render;
     request.checkpoint_seconds = a.checkpoint_seconds;
+    request.strength = a.strength;
+    request.bounds.effort = a.effort_bound;
+    request.bounds.distance = a.max_distance;
     std::string task_name = a.task;
     if (const auto slash = task_name.find_last_of('/'); slash != std::string::npos)
       task_name = task_name.substr(slash + 1);

@@ -37,7 +37,15 @@ struct SeedArgs {
   std::vector<double> check_sigmas{0.02, 0.05};
   int check_samples = 32;
   int from_stage = 0;
+  double strength = 1.0;
 };
+
+// The task at the strength asked for (Task::strength).
+Task task_at_strength(const SeedArgs& args) {
+  Task task = load_task(resolve_task_path(args.task));
+  task.strength = args.strength;
+  return task;
+}
 
 // "tasks/x.m0.json" -> "tasks/x"; "a/b.json" -> "a/b".
 std::string output_stem(const std::string& path) {
@@ -49,7 +57,7 @@ std::string output_stem(const std::string& path) {
 }
 
 void check(const SeedArgs& args) {
-  const Task task = load_task(resolve_task_path(args.task));
+  const Task task = task_at_strength(args);
   const TaskEvaluator ev(task);
   const std::string path = args.start.empty() ? task.m0 : args.start;
   const ParameterSet p = ev.load_parameters(path);
@@ -72,7 +80,7 @@ void check(const SeedArgs& args) {
 
 void run(const SeedArgs& args) {
   if (args.robustness_check) return check(args);
-  const Task task = load_task(resolve_task_path(args.task));
+  const Task task = task_at_strength(args);
   const TaskEvaluator ev(task);
   const std::string start_path = args.start.empty() ? task.seed.base : args.start;
   if (start_path.empty()) {
@@ -130,6 +138,11 @@ void run(const SeedArgs& args) {
                " --perturbation-sigma " + sigma;
   }
   if (args.from_stage > 0) command += " --from-stage " + std::to_string(args.from_stage);
+  if (args.strength != 1.0) {
+    char strength[32];
+    std::snprintf(strength, sizeof(strength), "%g", args.strength);
+    command += std::string(" --strength ") + strength;
+  }
   if (args.min_flight_rotation_deg > 0) {
     char deg[32];
     std::snprintf(deg, sizeof(deg), "%g", args.min_flight_rotation_deg);
@@ -174,6 +187,11 @@ void install(CLI::App& app) {
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or task file")->required();
   cmd->add_option("--start", args->start, "Starting parameters (default: the task's seed.base)");
   cmd->add_option("--out", args->out, "Output file (default: the task's m0 file)");
+  cmd->add_option("--strength", args->strength,
+                  "Strength model: every joint's PD gains and torque limits times S (an input "
+                  "motion for a stronger or weaker character; start it from the task's M0)")
+      ->capture_default_str()
+      ->check(number_in(kMinStrength, kMaxStrength));
   cmd->add_option("--threads", args->threads, "Worker threads")->check(integer_in(1, kMaxThreads));
   cmd->add_option("--generations", args->generations,
                   "CMA-ES generations per stage (default: the task's seed.generations)")

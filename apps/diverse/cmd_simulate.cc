@@ -4,7 +4,8 @@
 // (the exact MJCF text the motion ran on), and DIR/filmstrip.png with the
 // character at the phase events. A parameter file may also give the body shape as scales
 // "shape.NAME" (docs/shapes.md; a scale left out is 1); a motion file of a run with
-// varying shape is such a file.
+// varying shape is such a file. `--strength S` simulates the strength model S (every
+// joint's PD gains and torque limits times S; model.xml carries the limits).
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -30,11 +31,13 @@ struct SimulateArgs {
   std::string params;
   std::string out;
   bool no_film = false;
+  double strength = 1.0;
 };
 
 void run(const SimulateArgs& args) {
   namespace fs = std::filesystem;
-  const Task task = load_task(resolve_task_path(args.task));
+  Task task = load_task(resolve_task_path(args.task));
+  task.strength = args.strength;
   const TaskEvaluator ev(task);
   const std::string params_path = args.params.empty() ? task.m0 : args.params;
   const ParameterSet params = ev.load_shaped_parameters(params_path);
@@ -61,6 +64,9 @@ void run(const SimulateArgs& args) {
   }
   std::printf("C = %.6g%s%s\n", e.constraint, e.fell ? ", fell: " : "",
               e.fell ? e.summary.fall_reason.c_str() : "");
+  std::printf("effort %.6g N^2 m^2 s, positive work %.6g J\n", e.stats.effort, e.stats.positive_work);
+  if (task.strength != 1.0)
+    std::printf("strength %g: every joint's PD gains and torque limits times %g\n", task.strength, task.strength);
   if (e.failed) std::printf("failed: %s\n", e.failure.c_str());
   for (size_t p = 0; p < e.phases.names.size(); ++p) {
     if (e.phases.begin[p] < 0) {
@@ -114,6 +120,10 @@ void install(CLI::App& app) {
   cmd->add_option("--params", args->params, "Parameter file (default: the task's M0)");
   cmd->add_option("--out", args->out, "Output directory")->required();
   cmd->add_flag("--no-film", args->no_film, "Do not render the film strip");
+  cmd->add_option("--strength", args->strength,
+                  "Strength model: every joint's PD gains and torque limits times S")
+      ->capture_default_str()
+      ->check(number_in(kMinStrength, kMaxStrength));
   cmd->callback([args] { run(*args); });
 }
 

@@ -135,6 +135,10 @@ struct Character {
   std::vector<int> links;              // every body of the character, model order
   double total_mass = 0;               // kg
   double height = 0;                   // m, standing: lowest to highest geom point at qpos0
+  // The strength model (Task::strength, `diverse run --strength`): controllers multiply
+  // every joint PD gain (kp, kd) by it. The torque limits need nothing here: the model's
+  // forceranges carry the same factor (torque_limit above is read from them).
+  double strength = 1.0;
 
   // Index of a group by name, or -1.
   int find_group(const std::string& name) const;

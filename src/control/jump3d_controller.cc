@@ -385,11 +385,13 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
     for (size_t k = 0; k < n; ++k) {
       const int gs = gain_slot_[static_cast<size_t>(body_.joints[k].group)];
       const JointGroup& g = body_.groups[static_cast<size_t>(body_.joints[k].group)];
+      // The strength model scales every joint's PD gains (Character::strength).
+      const double s = body_.strength;
       if (gs >= 0) {
-        stance_->set_joint_gains(static_cast<int>(k), kp_[static_cast<size_t>(phase)][static_cast<size_t>(gs)],
-                                 kd_[static_cast<size_t>(phase)][static_cast<size_t>(gs)]);
+        stance_->set_joint_gains(static_cast<int>(k), s * kp_[static_cast<size_t>(phase)][static_cast<size_t>(gs)],
+                                 s * kd_[static_cast<size_t>(phase)][static_cast<size_t>(gs)]);
       } else {
-        stance_->set_joint_gains(static_cast<int>(k), g.kp, g.kd);
+        stance_->set_joint_gains(static_cast<int>(k), s * g.kp, s * g.kd);
       }
     }
     stance_->set_root_gains(2 * kp_[static_cast<size_t>(phase)][0], 2 * kd_[static_cast<size_t>(phase)][0]);
@@ -565,8 +567,8 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
     const CharacterJoint& j = body_.joints[k];
     const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
     const int gs = gain_slot_[static_cast<size_t>(j.group)];
-    const double p = gs >= 0 ? kp[static_cast<size_t>(gs)] : g.kp;
-    const double v = gs >= 0 ? kd[static_cast<size_t>(gs)] : g.kd;
+    const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)] : g.kp);
+    const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)] : g.kd);
     drive.set(static_cast<int>(k), p * (target_[k] - d->qpos[j.qpos]), v);
   }
 }

@@ -439,8 +439,9 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
     const CharacterJoint& j = body_.joints[i];
     const JointGroup& group = body_.groups[static_cast<size_t>(j.group)];
     const int gs = gain_slot_[static_cast<size_t>(j.group)];
-    const double kp = gs >= 0 ? kp_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kp;
-    const double kd = gs >= 0 ? kd_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kd;
+    // The strength model scales every joint's PD gains (Character::strength).
+    const double kp = body_.strength * (gs >= 0 ? kp_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kp);
+    const double kd = body_.strength * (gs >= 0 ? kd_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kd);
     double world_damping = 0;
     if (stance && tracked_[i] != Tracked::kNone) {
       const double child_rate = body_.child_pitch_rate(v, static_cast<int>(i));

@@ -195,8 +195,8 @@ StanceController::StanceController(const Character& body, const mjModel* m, Stan
   for (int k = 0; k < n; ++k) {
     const CharacterJoint& j = body.joints[static_cast<size_t>(k)];
     targets_[static_cast<size_t>(k)] = m->qpos0[j.qpos];
-    kp_.push_back(body.groups[static_cast<size_t>(j.group)].kp);
-    kd_gain_.push_back(body.groups[static_cast<size_t>(j.group)].kd);
+    kp_.push_back(body.strength * body.groups[static_cast<size_t>(j.group)].kp);
+    kd_gain_.push_back(body.strength * body.groups[static_cast<size_t>(j.group)].kd);
     index_of[static_cast<size_t>(j.joint)] = k;
     if (m->body_parentid[j.body] == root) root_children_.push_back(k);
   }

@@ -567,8 +567,9 @@ void WalkController::control(const mjModel* m, mjData* d, const ContactState& co
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
       const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
       const double* a = d->xaxis + 3 * j.joint;
-      u_[static_cast<size_t>(k)] = g.kp * dot3(a, e) - g.kd * dot3(a, w_parent);
-      kd_[static_cast<size_t>(k)] = g.kd;
+      const double kp = body_.strength * g.kp, kd = body_.strength * g.kd;
+      u_[static_cast<size_t>(k)] = kp * dot3(a, e) - kd * dot3(a, w_parent);
+      kd_[static_cast<size_t>(k)] = kd;
     }
   };
   for (int k = 0; k < n; ++k) {
@@ -577,8 +578,8 @@ void WalkController::control(const mjModel* m, mjData* d, const ContactState& co
     const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
     if (slot.kind == Kind::kJoint || slot.kind == Kind::kHold) {
       const double target = slot.kind == Kind::kHold ? qpos0_[static_cast<size_t>(k)] : t[static_cast<size_t>(slot.param)];
-      u_[static_cast<size_t>(k)] = g.kp * (target - d->qpos[j.qpos]);
-      kd_[static_cast<size_t>(k)] = g.kd;
+      u_[static_cast<size_t>(k)] = body_.strength * g.kp * (target - d->qpos[j.qpos]);
+      kd_[static_cast<size_t>(k)] = body_.strength * g.kd;
     }
   }
   track(femur_[static_cast<size_t>(swing)]);

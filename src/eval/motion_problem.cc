@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/error.h"
+
 namespace diverse {
 
 MetricLayout MotionProblem::layout_for(const TaskEvaluator& evaluator) {
@@ -25,10 +27,39 @@ MetricLayout MotionProblem::layout_for(const TaskEvaluator& evaluator) {
   return layout;  // shape_weights empty: w_i = 1 (paper section 4.2)
 }
 
+nlohmann::json to_json(const MotionBounds& bounds) {
+  nlohmann::json j = nlohmann::json::object();
+  if (bounds.effort > 0) j["effort"] = bounds.effort;
+  if (bounds.distance > 0) j["distance"] = bounds.distance;
+  return j;
+}
+
+MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string& where) {
+  MotionBounds bounds;
+  if (j.is_null()) return bounds;
+  if (!j.is_object()) throw_field_error(where, "bounds", "expected an object");
+  for (const auto& item : j.items())
+    if (item.key() != "effort" && item.key() != "distance")
+      throw_field_error(where, "bounds." + item.key(), "expected only the keys effort and distance");
+  auto number = [&](const char* key, bool open_low, double lo, double hi, const char* range) {
+    if (!j.contains(key)) return 0.0;
+    const nlohmann::json& v = j.at(key);
+    const double x = v.is_number() ? v.get<double>() : std::nan("");
+    if (!((open_low ? x > lo : x >= lo) && x <= hi))
+      throw_field_error(where, std::string("bounds.") + key, std::string("expected a number in ") + range);
+    return x;
+  };
+  bounds.effort = number("effort", false, kMinEffortBound, kMaxEffortBound, "[1, 1e6]");
+  bounds.distance = number("distance", true, 0, kMaxDistanceBound, "(0, 1e12]");
+  return bounds;
+}
+
 MotionProblem::MotionProblem(const TaskEvaluator& evaluator, DistanceSpec distance,
-                             Eigen::VectorXd reference, int workers, bool vary_shape)
+                             Eigen::VectorXd reference, int workers, bool vary_shape,
+                             MotionBounds bounds)
     : evaluator_(&evaluator),
       distance_(distance),
+      bounds_(bounds),
       vary_shape_(vary_shape),
       reference_(std::move(reference)),
       layout_(layout_for(evaluator)),
@@ -56,6 +87,15 @@ MotionProblem::MotionProblem(const TaskEvaluator& evaluator, DistanceSpec distan
   if (workers < 1) throw std::logic_error("MotionProblem: at least one worker");
   for (int w = 0; w < workers; ++w) workers_.push_back(evaluator.make_worker());
   if (vary_shape_) shaped_.resize(static_cast<std::size_t>(workers));
+  if (bounds_.any()) {
+    reference_outcome_ = simulate_outcome(reference_, 0);
+    if (reference_outcome_->failed)
+      throw UserError(evaluator.task().file + ": the input motion fails (" +
+                      (bounds_.effort > 0 ? std::string("--effort-bound") : std::string("--max-distance")) +
+                      " needs it as the reference)");
+    if (bounds_.effort > 0 && !(reference_outcome_->effort > 0))
+      throw UserError("--effort-bound: the input motion's effort is 0; nothing to bound by");
+  }
 }
 
 MotionProblem::MotionProblem(const TaskEvaluator& evaluator, Metric metric, Eigen::VectorXd reference,
@@ -82,6 +122,30 @@ ParameterSet MotionProblem::named(const Eigen::VectorXd& x) const {
 
 std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
                                                       int worker) const {
+  auto outcome = simulate_outcome(x, worker);
+  if (bounds_.any()) apply_bounds(*outcome);
+  return outcome;
+}
+
+void MotionProblem::apply_bounds(MotionOutcome& outcome) const {
+  if (outcome.failed) return;  // already as bad as it gets
+  const double weight = evaluator_->task().constraints.weight;
+  const MotionOutcome& m0 = *reference_outcome_;
+  if (bounds_.effort > 0) {
+    outcome.effort_ratio = outcome.effort / m0.effort;
+    const double e = std::max(0.0, outcome.effort_ratio / bounds_.effort - 1.0);
+    outcome.constraint += weight * e * e;
+  }
+  if (bounds_.distance > 0) {
+    outcome.distance_to_m0 = distance(outcome, m0);
+    const double e = std::max(0.0, outcome.distance_to_m0 / bounds_.distance - 1.0);
+    outcome.constraint += weight * e * e;
+  }
+  if (!std::isfinite(outcome.constraint)) outcome.failed = true;
+}
+
+std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::VectorXd& x,
+                                                               int worker) const {
   const auto w = static_cast<std::size_t>(worker);
   auto outcome = std::make_shared<MotionOutcome>();
   Evaluation e;
@@ -122,6 +186,9 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
     }
   }
   outcome->constraint = e.constraint;
+  outcome->task_constraint = e.constraint;
+  outcome->effort = e.stats.effort;
+  outcome->positive_work = e.stats.positive_work;
   outcome->failed = e.failed || !std::isfinite(e.constraint);
   outcome->fell = e.fell;
   outcome->landing_x = e.summary.feet_x;
@@ -210,6 +277,11 @@ std::string MotionProblem::encode(const Outcome& outcome) {
   w.put(static_cast<std::uint8_t>(m.fell));
   w.put(m.landing_x);
   w.put(m.peak_com_z);
+  w.put(m.task_constraint);
+  w.put(m.effort);
+  w.put(m.positive_work);
+  w.put(m.effort_ratio);
+  w.put(m.distance_to_m0);
   w.put_doubles(m.scales.data(), m.scales.size());
   w.put_doubles(m.features.link_lengths.data(), m.features.link_lengths.size());
   w.put(static_cast<std::uint64_t>(m.features.poses.size()));
@@ -231,6 +303,11 @@ std::shared_ptr<const Outcome> MotionProblem::decode(const std::string& bytes) {
   m->fell = r.get<std::uint8_t>() != 0;
   m->landing_x = r.get<double>();
   m->peak_com_z = r.get<double>();
+  m->task_constraint = r.get<double>();
+  m->effort = r.get<double>();
+  m->positive_work = r.get<double>();
+  m->effort_ratio = r.get<double>();
+  m->distance_to_m0 = r.get<double>();
   m->scales = r.vector();
   m->features.link_lengths = r.vector();
   const auto poses = r.get<std::uint64_t>();

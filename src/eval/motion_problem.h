@@ -20,11 +20,26 @@
 // next sample has the very same scales (M0, re-evaluated means): the scene is a pure
 // function of the scales, so results do not depend on what a worker ran before.
 //
+// Bounds (SPEC section 10; paper section 7.2 names them as future work). Beyond the
+// task's constraints a variation can be held
+//   - within R times M0's control effort (`diverse run --effort-bound R`): effort is the
+//     time integral of the sum of squared net joint torques over the whole rollout
+//     (physics/rollout.h, RolloutStats::effort), so a variation may not strain the
+//     character more than R times as much as the input motion does;
+//   - within X of M0 in the problem's own distance (`diverse run --max-distance X`), for
+//     subtle variations.
+// A bound is a constraint like the task's: its excess adds K_c e^2 to C (K_c the task's
+// constraint weight, e the relative excess, effort / (R effort(M0)) - 1 or d(M, M0) / X - 1),
+// so a variation past it ranks below every one within it, and C = 0 only within every
+// bound. M0 itself is within both (ratio 1, distance 0; R >= 1). The problem evaluates M0
+// once when it is made (every process does, under mpirun: the same outcome bit for bit).
+//
 // Thread safety: one SimWorker per worker index, created up front; evaluate() with a
 // given worker index is never called concurrently (DiversityProblem's contract).
 #pragma once
 
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -33,6 +48,21 @@
 #include "task/evaluate.h"
 
 namespace diverse {
+
+// Bounds on every variation besides the task's constraints (see above); 0 = no bound.
+struct MotionBounds {
+  double effort = 0;    // R >= 1: effort(M) <= R effort(M0)
+  double distance = 0;  // X > 0: d(M, M0) <= X in the problem's distance
+  bool any() const { return effort > 0 || distance > 0; }
+};
+// Ranges of the bounds (`--effort-bound`, `--max-distance`).
+constexpr double kMinEffortBound = 1.0, kMaxEffortBound = 1e6;
+constexpr double kMaxDistanceBound = 1e12;
+// {"effort": R, "distance": X}, the bounds that are set only.
+nlohmann::json to_json(const MotionBounds& bounds);
+// Reads to_json()'s object (null = no bounds). Throws UserError "WHERE: FIELD: expected
+// ..." for a field that is not a number in its range or an unknown field.
+MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string& where);
 
 // The outcome of one rollout.
 struct MotionOutcome : Outcome {
@@ -44,6 +74,11 @@ struct MotionOutcome : Outcome {
   bool fell = false;
   double landing_x = 0;      // m, mean foot x at rest (or at the end)
   double peak_com_z = 0;     // m
+  double task_constraint = 0;  // C of the task's own constraints (constraint adds the bounds')
+  double effort = 0;           // N^2 m^2 s, RolloutStats::effort
+  double positive_work = 0;    // J, RolloutStats::positive_work
+  double effort_ratio = 0;     // effort / effort(M0), with an effort bound (else 0)
+  double distance_to_m0 = 0;   // d(M, M0) in the problem's distance, with a distance bound
 };
 
 class MotionProblem : public DiversityProblem {
@@ -52,7 +87,7 @@ class MotionProblem : public DiversityProblem {
   // (parameters().normalized() of M0: with vary_shape, followed by its shape's). A
   // distance that uses the shape needs vary_shape (std::logic_error otherwise).
   MotionProblem(const TaskEvaluator& evaluator, DistanceSpec distance, Eigen::VectorXd reference,
-                int workers, bool vary_shape = false);
+                int workers, bool vary_shape = false, MotionBounds bounds = {});
   // A motion-only problem under one motion metric.
   MotionProblem(const TaskEvaluator& evaluator, Metric metric, Eigen::VectorXd reference,
                 int workers);
@@ -83,6 +118,10 @@ class MotionProblem : public DiversityProblem {
   static std::string encode(const Outcome& outcome);
   static std::shared_ptr<const Outcome> decode(const std::string& bytes);
 
+  const MotionBounds& bounds() const { return bounds_; }
+  // M0's outcome (the reference's), kept when a bound is set (else null).
+  const MotionOutcome* reference_outcome() const { return reference_outcome_.get(); }
+
   Metric metric() const { return distance_.metric; }
   const DistanceSpec& distance_spec() const { return distance_; }
   bool vary_shape() const { return vary_shape_; }
@@ -101,8 +140,15 @@ class MotionProblem : public DiversityProblem {
     std::unique_ptr<SimWorker> worker;
   };
 
+  // The rollout alone, without the bounds.
+  std::shared_ptr<MotionOutcome> simulate_outcome(const Eigen::VectorXd& x, int worker) const;
+  // Adds the bounds' terms to an outcome's constraint.
+  void apply_bounds(MotionOutcome& outcome) const;
+
   const TaskEvaluator* evaluator_;
   DistanceSpec distance_;
+  MotionBounds bounds_;
+  std::shared_ptr<const MotionOutcome> reference_outcome_;
   bool vary_shape_ = false;
   Eigen::VectorXd reference_;
   ParameterSet parameters_;

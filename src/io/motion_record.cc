@@ -77,6 +77,9 @@ nlohmann::json motion_record_json(const TaskEvaluator& evaluator, const Paramete
   j["constraint"] = {{"total", e.constraint}, {"fell", e.fell}, {"failed", e.failed},
                      {"failure", e.failure}, {"terms", terms}};
   j["summary"] = summary_json(e.summary);
+  j["strength"] = evaluator.task().strength;
+  j["effort"] = e.stats.effort;
+  j["positive_work"] = e.stats.positive_work;
 
   nlohmann::json phases = nlohmann::json::array();
   for (std::size_t p = 0; p < e.phases.names.size(); ++p) {

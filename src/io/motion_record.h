@@ -13,6 +13,8 @@
 //                                                  (m) of the shape distance
 //     "constraint": {"total": C, "fell": false, "terms": [{"name", "violation", "penalty"}]},
 //     "summary": {peak COM height, feet position at the end, rotation, ...},
+//     "strength": 1,                               the strength model it ran at (Task::strength)
+//     "effort": E, "positive_work": W,             N^2 m^2 s and J (physics/rollout.h)
 //     "phases": [{"name": "start", "begin": 0.0}, ...],   begin times (s), -1 if never;
 //                                                  "event": "takeoff", "peak" or "landing"
 //                                                  on the phases those events begin

@@ -206,7 +206,8 @@ nlohmann::json to_json(const DiversityRecord& r) {
   return {{"generation", r.generation}, {"step", r.step},
           {"variation", r.variation},   {"D", r.D},
           {"best_D", r.best_D},         {"constraint", vector_json(r.constraint)},
-          {"dmin", vector_json(r.dmin)}, {"evaluations", r.evaluations}};
+          {"dmin", vector_json(r.dmin)}, {"evaluations", r.evaluations},
+          {"samples", r.samples},       {"feasible", r.feasible}};
 }
 
 namespace {
@@ -221,6 +222,9 @@ DiversityRecord record_from_json(const nlohmann::json& j) {
   r.constraint = vector_from_json(j.at("constraint"));
   r.dmin = vector_from_json(j.at("dmin"));
   r.evaluations = integer_from_json<long long>(j.at("evaluations"), "log.evaluations");
+  // Absent from checkpoints written before they were counted.
+  if (j.contains("samples")) r.samples = integer_from_json<int>(j.at("samples"), "log.samples");
+  if (j.contains("feasible")) r.feasible = integer_from_json<int>(j.at("feasible"), "log.feasible");
   return r;
 }
 
@@ -405,6 +409,7 @@ void DiversityOptimizer::step_variation(int v) {
   const auto outcomes = evaluate_all(batch);
   if (pending_ > 0) settle_pending(outcomes.back());
   evaluations_ += static_cast<long long>(xs.size());
+  count_samples(outcomes, xs.size());
 
   // Each sample replaces M_v in the current set and is ranked by its D and its own C.
   std::vector<double> D(xs.size()), C(xs.size());
@@ -432,6 +437,14 @@ void DiversityOptimizer::step_variation(int v) {
   pending_ = v;
 }
 
+void DiversityOptimizer::count_samples(const std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                                       std::size_t n) {
+  step_samples_ = static_cast<int>(n);
+  step_feasible_ = 0;
+  for (std::size_t k = 0; k < n; ++k)
+    if (scored_constraint(*outcomes[k]) == 0.0) ++step_feasible_;
+}
+
 void DiversityOptimizer::step_simultaneous() {
   const int n = options_.variations;
   // Every instance still running draws its generation; one batch holds them all.
@@ -449,6 +462,7 @@ void DiversityOptimizer::step_simultaneous() {
   if (active.empty()) return;
   const auto outcomes = evaluate_all(batch);
   evaluations_ += static_cast<long long>(batch.size());
+  count_samples(outcomes, batch.size());
 
   // Each sample of variation v replaces M_v in the set as it stood when the generation
   // was drawn, ranked by its D and its own C; every instance learns from that.
@@ -526,6 +540,7 @@ void DiversityOptimizer::step_joint() {
     for (int v = 0; v < n; ++v) motions.push_back(xs[k].segment(v * dim, dim));
   const std::vector<std::shared_ptr<const Outcome>> outcomes = evaluate_all(motions);
   evaluations_ += static_cast<long long>(lambda * n);
+  count_samples(outcomes, outcomes.size());
   std::vector<double> D(lambda), C(lambda);
   pool_->parallel_for(lambda, [&](std::size_t k, int) {
     std::vector<std::shared_ptr<const Outcome>> set{outcomes_.front()};
@@ -575,6 +590,8 @@ void DiversityOptimizer::finish_step(int variation) {
   record.constraint = current_.constraint;
   record.dmin = current_.dmin;
   record.evaluations = evaluations_;
+  record.samples = step_samples_;
+  record.feasible = step_feasible_;
   log_.push_back(record);
 
   // A path records where a variation went: a point for every step that moved it.

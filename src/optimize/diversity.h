@@ -156,6 +156,8 @@ struct DiversityRecord {
   Eigen::VectorXd constraint;  // C(M_i) of the current set, i = 0..(motions present - 1)
   Eigen::VectorXd dmin;        // dmin(M_i) of the current set, same indexing
   long long evaluations = 0;   // evaluations so far, including this step's
+  int samples = 0;             // the step's samples (joint: motions of its sample sets)
+  int feasible = 0;            // of those, how many met their constraints (C = 0)
 };
 nlohmann::json to_json(const DiversityRecord& record);
 
@@ -286,6 +288,10 @@ class DiversityOptimizer {
   long long phase_budget_ = 0;
   // Variation whose new mean awaits evaluation (0 = none); always 0 between generations.
   int pending_ = 0;
+  // The last step's sample count and how many of them met their constraints, for its
+  // log record (with kMean the record is made one evaluation later).
+  int step_samples_ = 0, step_feasible_ = 0;
+  void count_samples(const std::vector<std::shared_ptr<const Outcome>>& outcomes, std::size_t n);
   bool in_step_ = false;
 
   std::vector<DiversityRecord> log_;

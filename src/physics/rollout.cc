@@ -103,6 +103,20 @@ void record_step(const mjModel* m, const mjData* d, const std::vector<int>& damp
   for (int dof : damped_dofs) r->damping_force.push_back(-m->dof_damping[dof] * d->qvel[dof]);
 }
 
+// One step's share of the rollout's effort and positive work (RolloutStats).
+void add_effort(const mjModel* m, const mjData* d, const JointDrive& drive, RolloutStats* stats) {
+  const double h = m->opt.timestep;
+  double squared = 0, power = 0;
+  for (const DrivenJoint& j : drive.joints()) {
+    const double qdot = d->qvel[j.dof];
+    const double net = d->actuator_force[j.actuator] - m->dof_damping[j.dof] * qdot;
+    squared += net * net;
+    power += std::max(0.0, net * qdot);
+  }
+  stats->effort += h * squared;
+  stats->positive_work += h * power;
+}
+
 // The loop of both run_rollout() overloads: `drive` null means the hooks write ctrl and
 // dof_damping of `damped_dofs` themselves.
 RolloutStats rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
@@ -146,6 +160,7 @@ RolloutStats rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
       break;
     }
     ++stats.steps;
+    if (drive != nullptr) add_effort(m, d, *drive, &stats);
     if (recorder != nullptr) record_step(m, d, damped_dofs, step, recorder);
     if (simulation_unstable(m, d, &stats.instability)) {
       stats.unstable = true;

@@ -60,6 +60,11 @@ struct StepRecorder {
 struct RolloutStats {
   int steps = 0;           // integration steps taken
   double time = 0;         // simulated time at the end (s)
+  // Control effort of a rollout with a JointDrive (0 without one), over every step taken,
+  // from each driven joint's net torque tau (motor plus damping on the end-of-step
+  // velocity, as the drive bounds it) and its end-of-step velocity qdot:
+  double effort = 0;         // N^2 m^2 s: the time integral of sum_k tau_k^2
+  double positive_work = 0;  // J: the time integral of sum_k max(0, tau_k qdot_k)
   bool unstable = false;   // stopped because the simulation blew up
   std::string instability; // what blew up
 };

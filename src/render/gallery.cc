@@ -459,7 +459,7 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                          {"metric", run.metric},
                          {"fps", options.fps}};
   for (const char* key : {"N", "K", "strategy", "seed", "generations", "evaluations", "D",
-                          "all_satisfied", "stop"})
+                          "all_satisfied", "stop", "strength", "bounds"})
     if (s.contains(key)) data["run"][key] = s[key];
 
   nlohmann::json models = nlohmann::json::array();
@@ -488,6 +488,11 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                        {"status", m.status()},
                        {"duration", m.duration()},
                        {"frames", body_frames_json(m.model->get(), sampled[i])}});
+    // Effort and distance from M0, and whether the motion keeps the run's bounds.
+    if (s.contains("motions") && s["motions"].is_array() && i < s["motions"].size() &&
+        s["motions"][i].is_object())
+      for (const char* key : {"effort", "effort_ratio", "positive_work", "distance_to_m0", "within_bounds"})
+        if (s["motions"][i].contains(key)) motions.back()[key] = s["motions"][i][key];
   }
   nlohmann::json strips = nlohmann::json::array();
   // [x0, x1] along the track, or [x0, x1, y, radius] for a disc centred between x0 and x1.

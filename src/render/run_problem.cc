@@ -44,8 +44,16 @@ RunProblem open_run_problem(const RunView& run, int threads, const std::string& 
     throw UserError(run_file.string() + ": task_file: " + task_file + " is missing; " + consequence);
   if (read_file(task_file) != run.run.value("task_text", std::string()))
     throw UserError(run_file.string() + ": task_file: " + task_file + " changed since the run; " + consequence);
+  // The run's strength model and bounds (absent in older runs: 1 and none), so that new
+  // points are simulated and judged as the run judged its samples.
+  Task task = load_task(task_file);
+  const nlohmann::json strength = run.run.value("strength", nlohmann::json(1.0));
+  if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
+    throw_field_error(run_file.string(), "strength", "expected a number in [0.1, 10]");
+  task.strength = strength.get<double>();
+  const MotionBounds bounds = motion_bounds_from_json(run.run.value("bounds", nlohmann::json()), run_file.string());
   RunProblem p;
-  auto evaluator = std::make_unique<const TaskEvaluator>(load_task(task_file));
+  auto evaluator = std::make_unique<const TaskEvaluator>(std::move(task));
   const DistanceSpec distance =
       parse_distance(run.metric, run.run.value("shape_weight", kDefaultShapeWeight),
                      (run.dir / "summary.json").string() + ": metric", run_file.string() + ": shape_weight");
@@ -55,7 +63,8 @@ RunProblem open_run_problem(const RunView& run, int threads, const std::string& 
   if (p.vary_shape) p.like = evaluator->with_shape(p.like, evaluator->shapes().identity());
   for (const RunMotion& m : run.motions) p.motions.push_back(motion_parameters(p.like, m.file).normalized());
   const int workers = threads > 0 ? threads : ThreadPool::hardware_threads();
-  p.problem = std::make_unique<const MotionProblem>(*evaluator, distance, p.motions.front(), workers, p.vary_shape);
+  p.problem = std::make_unique<const MotionProblem>(*evaluator, distance, p.motions.front(), workers, p.vary_shape,
+                                                    bounds);
   p.evaluator = std::move(evaluator);
   return p;
 }

@@ -122,9 +122,18 @@ void write_run_outputs(const RunOutputs& o) {
 
   // A character without shape parameters has no scales and no link lengths.
   const ShapeSpace* shapes = o.evaluator.has_shape() ? &o.evaluator.shapes() : nullptr;
+  // Effort and distance from M0 of every motion, and whether it keeps the run's bounds.
+  const MotionBounds& bounds = o.problem.bounds();
+  const auto& m0_outcome = static_cast<const MotionOutcome&>(*result.outcomes[0]);
   nlohmann::json motions = nlohmann::json::array();
   for (std::size_t i = 0; i < count; ++i) {
     const auto& outcome = static_cast<const MotionOutcome&>(*result.outcomes[i]);
+    const double effort_ratio = m0_outcome.effort > 0 ? outcome.effort / m0_outcome.effort : 0.0;
+    const double from_m0 = (is_failure(outcome) || is_failure(m0_outcome))
+                               ? 0.0 : o.problem.distance(outcome, m0_outcome);
+    const bool within = !is_failure(outcome) &&
+                        (bounds.effort <= 0 || effort_ratio <= bounds.effort) &&
+                        (bounds.distance <= 0 || from_m0 <= bounds.distance);
     const auto idx = static_cast<Eigen::Index>(i);
     nlohmann::json scales = nlohmann::json::object();
     for (int p = 0; p < outcome.scales.size(); ++p)
@@ -134,6 +143,12 @@ void write_run_outputs(const RunOutputs& o) {
                        {"label", label(i)},
                        {"constraint", result.score.constraint[idx]},
                        {"dmin", result.score.dmin[idx]},
+                       {"task_constraint", outcome.task_constraint},
+                       {"effort", outcome.effort},
+                       {"effort_ratio", effort_ratio},
+                       {"positive_work", outcome.positive_work},
+                       {"distance_to_m0", from_m0},
+                       {"within_bounds", within},
                        {"fell", outcome.fell},
                        {"failed", outcome.failed},
                        {"landing_x", outcome.landing_x},
@@ -142,6 +157,13 @@ void write_run_outputs(const RunOutputs& o) {
                        {"shape_scales", scales},
                        {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())},
                        {"file", "motions/" + stem(i) + ".json"}});
+  }
+
+  // How many of the optimizer's samples met their constraints (C = 0, bounds included).
+  long long samples = 0, feasible = 0;
+  for (const DiversityRecord& r : o.optimizer.log()) {
+    samples += r.samples;
+    feasible += r.feasible;
   }
 
   const TaskEvaluator& ev = o.evaluator;
@@ -164,6 +186,10 @@ void write_run_outputs(const RunOutputs& o) {
       {"stop", to_string(result.stop)},
       {"D", result.score.D},
       {"all_satisfied", (result.score.constraint.array() == 0.0).all()},
+      {"strength", ev.task().strength},
+      {"bounds", to_json(bounds)},
+      {"samples", samples},
+      {"feasible_samples", feasible},
       {"link_names", shapes ? shapes->link_names() : std::vector<std::string>()},
       {"motions", motions},
       {"distances", distances},

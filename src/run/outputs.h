@@ -29,7 +29,11 @@ struct RunOutputs {
 };
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"
-// the parameter groups), per motion its C, dmin, shape scales and link lengths (m,
+// the parameter groups, "strength", "bounds"; "samples" the optimizer's samples and
+// "feasible_samples" how many of them met their constraints), per motion its C (the
+// task's constraints and the bounds'; "task_constraint" the task's alone), dmin, effort
+// (N^2 m^2 s), "effort_ratio" to M0's, "positive_work" (J), "distance_to_m0" in the
+// objective's distance, "within_bounds", shape scales and link lengths (m,
 // "link_names" order; none for a character without shape parameters), and "distances": the pairwise matrices over M0..MN of every motion
 // metric (hf, md, wja) and of the shape metric (all zero when the shape did not vary),
 // plus the objective's own matrix when it combines a motion metric with the shape.

@@ -33,17 +33,25 @@ struct RunSetup {
   DistanceSpec distance;
   bool vary_shape = false;
   DiversityOptions options;
+  double strength = 1.0;  // Task::strength
+  MotionBounds bounds;
   ParameterSet m0;  // M0's parameters, with its shape (scale 1) when shape varies
   std::string task_path;
   std::string task_text;
 };
 
 RunSetup make_setup(const std::string& task_path, const std::string& metric_name,
-                    double shape_weight, bool vary_shape, const DiversityOptions& options) {
+                    double shape_weight, bool vary_shape, const DiversityOptions& options,
+                    double strength, const MotionBounds& bounds) {
   RunSetup setup;
   setup.task_path = fs::absolute(task_path).lexically_normal().string();
   setup.task_text = read_file(setup.task_path);
   Task task = load_task(setup.task_path);
+  if (!(strength >= kMinStrength && strength <= kMaxStrength))
+    throw UserError("--strength: expected a number in [0.1, 10], got " + std::to_string(strength));
+  task.strength = strength;
+  setup.strength = strength;
+  setup.bounds = bounds;
   const std::string metric = metric_name.empty() ? task.metric : metric_name;
   setup.distance =
       parse_distance(metric, shape_weight, metric_name.empty() ? task.file + ": metric" : "--metric");
@@ -73,7 +81,9 @@ nlohmann::json run_json(const RunSetup& setup) {
                       {"task_text", setup.task_text},
                       {"metric", to_string(setup.distance)},
                       {"vary", vary_json(setup.vary_shape)},
-                      {"options", to_json(setup.options)}};
+                      {"options", to_json(setup.options)},
+                      {"strength", setup.strength},
+                      {"bounds", to_json(setup.bounds)}};
   if (setup.distance.combined()) j["shape_weight"] = setup.distance.shape_weight;
   return j;
 }
@@ -102,6 +112,8 @@ std::string cluster_setup(const RunSetup& setup) {
                       {"metric", to_string(setup.distance)},
                       {"shape_weight", setup.distance.shape_weight},
                       {"vary_shape", setup.vary_shape},
+                      {"strength", setup.strength},
+                      {"bounds", to_json(setup.bounds)},
                       {"reference", std::vector<double>(m0.data(), m0.data() + m0.size())}};
   return j.dump();
 }
@@ -292,7 +304,7 @@ nlohmann::json without_timing(nlohmann::json summary) {
 void start_run(const RunRequest& request) {
   const int threads = resolve_threads(request.threads, request.cluster);
   RunSetup setup = make_setup(resolve_task_path(request.task), request.metric, request.shape_weight,
-                              request.vary_shape, request.options);
+                              request.vary_shape, request.options, request.strength, request.bounds);
   try {
     validate(setup.options);  // after the task's N has filled in variations = 0
   } catch (const std::invalid_argument& e) {
@@ -315,7 +327,7 @@ void start_run(const RunRequest& request) {
 
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
-                              setup.vary_shape);
+                              setup.vary_shape, setup.bounds);
   std::unique_ptr<BatchEvaluator> batch;
   std::unique_ptr<DiversityOptimizer> started;
   try {
@@ -325,6 +337,21 @@ void start_run(const RunRequest& request) {
     rethrow_resumable(e, request.out, -1);
   }
   DiversityOptimizer& optimizer = *started;
+  if (!request.quiet && optimizer.current_score().constraint[0] > 0) {
+    // Most often a strength model: the input motion was found for the character at 1.
+    char strength[32], c0[32];
+    std::snprintf(strength, sizeof strength, "%g", setup.strength);
+    std::snprintf(c0, sizeof c0, "%g", optimizer.current_score().constraint[0]);
+    const bool strong = setup.strength != 1.0;
+    std::fprintf(stderr,
+                 "diverse: note: the input motion M0 does not meet the task%s%s (C = %s); the "
+                 "variations start from it and must first find the task. To find an input motion "
+                 "for this character: `diverse seed-motion %s%s%s --start %s --out FILE`, then name "
+                 "FILE as m0 in a copy of the task file\n",
+                 strong ? " at strength " : "", strong ? strength : "", c0,
+                 setup.evaluator->task().name.c_str(), strong ? " --strength " : "", strong ? strength : "",
+                 setup.evaluator->task().m0.c_str());
+  }
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
         request.quiet, request.render, request.cluster, batch.get());
 }
@@ -358,16 +385,21 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
       throw UserError(where + ": task_file: " + task_file + " no longer exists");
     if (read_file(task_file) != task_text)
       throw UserError(task_file + ": changed since the run started; a resumed run must use the same task");
+    // Runs from before strength and bounds existed have neither: strength 1, no bounds.
+    const nlohmann::json& strength = run.contains("strength") ? run["strength"] : nlohmann::json(1.0);
+    if (!strength.is_number() || !(strength.get<double>() >= kMinStrength && strength.get<double>() <= kMaxStrength))
+      throw_field_error(where, "strength", "expected a number in [0.1, 10]");
     setup = make_setup(task_file, run.at("metric").get<std::string>(),
                        run.value("shape_weight", kDefaultShapeWeight), read_vary_shape(run, where),
-                       options);
+                       options, strength.get<double>(),
+                       motion_bounds_from_json(run.contains("bounds") ? run["bounds"] : nlohmann::json(), where));
   } catch (const nlohmann::json::exception& e) {
     throw UserError(where + ": expected the settings `diverse run` writes (" + e.what() + ")");
   }
 
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
-                              setup.vary_shape);
+                              setup.vary_shape, setup.bounds);
   // What a kill in the middle of a write left (the files themselves are whole: io/files.h).
   for (const char* sub : {"", "motions", "model", "paths"}) remove_stale_temporaries(dir / sub);
   double wall_before = 0.0;
@@ -421,7 +453,8 @@ void serve_run(Cluster& cluster, int threads_arg) {
     if (read_file(task_file) != j.at("task_text").get<std::string>())
       throw UserError(task_file + ": differs from rank 0's copy; every node needs the same task files");
     setup = make_setup(task_file, j.at("metric").get<std::string>(), j.at("shape_weight").get<double>(),
-                       j.at("vary_shape").get<bool>(), DiversityOptions{});
+                       j.at("vary_shape").get<bool>(), DiversityOptions{}, j.at("strength").get<double>(),
+                       motion_bounds_from_json(j.at("bounds"), "rank 0's settings"));
     const std::vector<double> reference = j.at("reference").get<std::vector<double>>();
     const Eigen::VectorXd m0 = setup.m0.normalized();
     if (static_cast<Eigen::Index>(reference.size()) != m0.size() ||
@@ -429,7 +462,7 @@ void serve_run(Cluster& cluster, int threads_arg) {
       throw UserError(setup.evaluator->task().m0 +
                       ": differs from rank 0's input motion; every node needs the same files");
     problem = std::make_unique<MotionProblem>(*setup.evaluator, setup.distance, m0, threads,
-                                              setup.vary_shape);
+                                              setup.vary_shape, setup.bounds);
   } catch (const std::exception& e) {
     cluster.refuse_setup(e.what());
     return;

@@ -5,7 +5,9 @@
 //   run.json            settings: task file (absolute path and its text), metric (and the
 //                       shape weight of a combined one), the parameter groups that vary
 //                       ("vary": ["control"] or ["control", "shape"]), the optimizer's
-//                       options, version
+//                       options, the character's strength ("strength", 1 when absent),
+//                       the bounds on the variations ("bounds": {"effort": R,
+//                       "distance": X}, eval/motion_problem.h), version
 //   checkpoint.json     the optimizer's complete state at a generation boundary, written
 //                       atomically (temp + rename) every few seconds and at the end
 //   log.jsonl           one JSON record per CMA step (generation, variation, D, C, dmin,
@@ -34,6 +36,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "eval/motion_problem.h"
 #include "optimize/diversity.h"
 
 namespace diverse {
@@ -47,6 +50,9 @@ struct RunRequest {
   bool vary_shape = false;          // the shape scales are free parameters too (the
                                     // character file's [shape] parameters)
   DiversityOptions options;         // variations = 0 means the task's N, sigma0 = 0 its sigma0
+  double strength = 1.0;            // the strength model: PD gains and torque limits times
+                                    // this (Task::strength), in [kMinStrength, kMaxStrength]
+  MotionBounds bounds;              // effort and distance bounds (eval/motion_problem.h)
   std::filesystem::path out;        // run directory
   int threads = 0;                  // 0 = one per core
   bool force = false;               // replace an existing run in `out`

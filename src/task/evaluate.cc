@@ -209,11 +209,32 @@ class JumpHooks : public StepHooks {
 TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
   model_ = SharedModel::from_xml(scene_xml(task_), task_.model);
   body_ = std::make_unique<Character>(bind_character(task_.character_spec, model_->get(), task_.model));
+  body_->strength = task_.strength;
+  if (task_.strength != 1.0) check_strength();
   check_scene(task_, model_->get(), *body_);
   task_.controller_type->check(*body_, task_.file);
   specs_ = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   if (task_.constraints.clearance) {
     obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());
+  }
+}
+
+void TaskEvaluator::check_strength() const {
+  // The scene at strength 1, compiled once, to see that every torque limit scaled: a
+  // limit the text did not carry as a forcerange attribute would have stayed as it was.
+  Task plain = task_;
+  plain.strength = 1.0;
+  const auto base = SharedModel::from_xml(scene_xml(plain), task_.model);
+  const std::vector<DrivenJoint> scaled = driven_joints(model_->get());
+  const std::vector<DrivenJoint> unscaled = driven_joints(base->get());
+  for (std::size_t k = 0; k < scaled.size() && k < unscaled.size(); ++k) {
+    const double want = task_.strength * unscaled[k].limit;
+    if (std::fabs(scaled[k].limit - want) > 1e-9 * want) {
+      const char* name = mj_id2name(model_->get(), mjOBJ_ACTUATOR, scaled[k].actuator);
+      throw UserError(task_.model + ": actuator '" + (name ? name : "?") +
+                      "': expected its torque limit in a forcerange attribute, which --strength "
+                      "scales, but it stayed " + std::to_string(scaled[k].limit) + " Nm");
+    }
   }
 }
 
@@ -435,7 +456,9 @@ std::shared_ptr<const ShapedScene> TaskEvaluator::shaped_scene(const Eigen::Vect
   scene->model = space.compile(scales, origin);  // validates
   scene->link_lengths = space.link_lengths(scales);
   scene->standing = space.standing(scales);
-  scene->body = std::make_shared<const Character>(bind_character(task_.character_spec, scene->model->get(), origin));
+  Character body = bind_character(task_.character_spec, scene->model->get(), origin);
+  body.strength = task_.strength;
+  scene->body = std::make_shared<const Character>(std::move(body));
   return scene;
 }
 

@@ -94,6 +94,8 @@ bool holds_shape(const ParameterSet& params);
 
 class TaskEvaluator {
  public:
+  // Compiles the task's scene at the task's strength (Task::strength: torque limits in
+  // the model, PD gains through Character::strength).
   explicit TaskEvaluator(Task task);
 
   const Task& task() const { return task_; }
@@ -168,6 +170,10 @@ class TaskEvaluator {
   std::unique_ptr<Character> body_;
   std::vector<ParamSpec> specs_;  // the controller's parameters for body_, named once
   int obstacle_geom_ = -1;
+
+  // With a strength other than 1: every driven joint's limit is the strength times its
+  // limit at strength 1; throws UserError naming an actuator whose limit did not scale.
+  void check_strength() const;
 
   // The rollout of a walk task (task/walk_eval.h), from the controller's start state.
   Evaluation evaluate_walk(Controller& controller, JointDrive& drive, const Character& body,

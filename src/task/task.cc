@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <regex>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -277,8 +278,37 @@ std::string resolve_task_path(const std::string& name_or_path) {
                   ": expected a task file or the name of one in tasks/ (no such task)");
 }
 
+namespace {
+
+// Every forcerange="lo hi" attribute of an MJCF text times `factor` (actuators and the
+// defaults they inherit from alike: in MuJoCo 2.2 only actuators have one).
+std::string scale_force_ranges(const std::string& xml, double factor, const std::string& origin) {
+  static const std::regex attribute(R"((forcerange\s*=\s*)(["'])([^"']*)\2)");
+  std::string out;
+  auto last = xml.cbegin();
+  for (std::sregex_iterator it(xml.begin(), xml.end(), attribute), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    std::istringstream in(m[3].str());
+    std::ostringstream scaled;
+    scaled.precision(17);
+    double value = 0;
+    int count = 0;
+    while (in >> value) scaled << (count++ > 0 ? " " : "") << value * factor;
+    if (count != 2 || !(in >> std::ws).eof())
+      throw UserError(origin + ": forcerange: expected two numbers, got \"" + m[3].str() + "\"");
+    out.append(last, m[0].first);
+    out += m[1].str() + m[2].str() + scaled.str() + m[2].str();
+    last = m[0].second;
+  }
+  out.append(last, xml.cend());
+  return out;
+}
+
+}  // namespace
+
 std::string scene_xml(const Task& task) {
   std::string xml = read_text_file(task.model, "model");
+  if (task.strength != 1.0) xml = scale_force_ranges(xml, task.strength, task.model);
   std::ostringstream geoms;
   geoms.precision(17);
   for (const SceneObject& o : task.objects) {

@@ -137,6 +137,10 @@ struct Task {
   TaskSeed seed;
   TaskDiversity diversity;
   TaskWalk walk;            // [walk]: a walk task (task/walk_task.h)
+  // The character's strength model (paper section 7.2, `diverse run --strength`; not a
+  // task-file field): every joint's torque limit (the motors' forcerange in the scene,
+  // scene_xml) and PD gains (Character::strength, applied by the controllers) times this.
+  double strength = 1.0;
 
   const SceneObject* find_object(const std::string& name) const;
 };
@@ -148,8 +152,14 @@ Task load_task(const std::string& path);
 // the current directory and then in the source tree. Throws UserError if none exists.
 std::string resolve_task_path(const std::string& name_or_path);
 
-// The task's MJCF: the character model with the scene objects added to its worldbody.
-// Throws UserError if the character file cannot be read.
+// The task's MJCF: the character model with the scene objects added to its worldbody,
+// and, for a strength other than 1, every forcerange attribute (actuators and their
+// defaults) scaled by it, so a saved model carries the scaled torque limits. Throws
+// UserError if the character file cannot be read.
 std::string scene_xml(const Task& task);
+
+// The range of Task::strength (`--strength`): [kMinStrength, kMaxStrength].
+constexpr double kMinStrength = 0.1;
+constexpr double kMaxStrength = 10.0;
 
 }  // namespace diverse

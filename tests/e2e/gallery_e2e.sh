@@ -37,9 +37,10 @@ else
   trap 'rm -rf "$work"' EXIT
 fi
 # Short but real: 2 variations, 3 generations of 8 samples, from a small step (the high
-# jump's feasible neighbourhood under the half-timestep check is thin).
+# jump's feasible neighbourhood under the half-timestep check is thin), within bounds the
+# page shows.
 "$diverse" run "$src/tasks/jump_high.toml" --n 2 --generations 3 --popsize 8 --sigma0 0.01 --seed 5 \
-  --quiet --no-render --out "$work/run"
+  --effort-bound 3 --max-distance 1000 --quiet --no-render --out "$work/run"
 "$diverse" blend "$work/run" --samples 12 --path-points 4
 "$diverse" gallery "$work/run"
 "$diverse" export "$work/run" --bvh --gltf

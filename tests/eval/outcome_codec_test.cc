@@ -45,6 +45,11 @@ void expect_identical(const MotionOutcome& a, const MotionOutcome& b) {
   EXPECT_EQ(a.fell, b.fell);
   EXPECT_TRUE(same_bits(&a.landing_x, &b.landing_x, 1));
   EXPECT_TRUE(same_bits(&a.peak_com_z, &b.peak_com_z, 1));
+  EXPECT_TRUE(same_bits(&a.task_constraint, &b.task_constraint, 1));
+  EXPECT_TRUE(same_bits(&a.effort, &b.effort, 1));
+  EXPECT_TRUE(same_bits(&a.positive_work, &b.positive_work, 1));
+  EXPECT_TRUE(same_bits(&a.effort_ratio, &b.effort_ratio, 1));
+  EXPECT_TRUE(same_bits(&a.distance_to_m0, &b.distance_to_m0, 1));
   ASSERT_EQ(a.scales.size(), b.scales.size());
   EXPECT_TRUE(same_bits(a.scales.data(), b.scales.data(), a.scales.size()));
   ASSERT_EQ(a.features.link_lengths.size(), b.features.link_lengths.size());
@@ -70,9 +75,13 @@ const MotionOutcome& motion(const std::shared_ptr<const Outcome>& o) {
 
 TEST(OutcomeCodec, RoundTripsAFlightBitForBit) {
   Fixture& f = fixture();
-  const MotionProblem problem(f.evaluator, DistanceSpec{Metric::kMassDistance, 0.0}, f.shaped_m0.normalized(), 1, true);
+  // With bounds, so that every field of the outcome holds a value.
+  const MotionProblem problem(f.evaluator, DistanceSpec{Metric::kMassDistance, 0.0}, f.shaped_m0.normalized(), 1, true,
+                              MotionBounds{1.5, 100.0});
   const auto outcome = problem.evaluate(f.shaped_m0.normalized(), 0);
   ASSERT_FALSE(outcome->failed);
+  ASSERT_EQ(motion(outcome).effort_ratio, 1.0);
+  ASSERT_GT(motion(outcome).effort, 0.0);
   ASSERT_EQ(motion(outcome).features.poses.size(), 20u);  // 10 per airborne phase
   ASSERT_GT(motion(outcome).scales.size(), 0);
   const std::string bytes = MotionProblem::encode(*outcome);

@@ -43,9 +43,13 @@ function fillHeader() {
   $('subtitle').textContent =
     `M0 and ${n} variation${n === 1 ? '' : 's'} found by diverse, metric ${(data.metric || '').toUpperCase()}` +
     (run.strategy ? `, ${run.strategy}` : '');
+  const bounds = run.bounds || {};
   const facts = [
     ['generations', run.generations], ['evaluations', run.evaluations], ['D', fmt(run.D)],
     ['constraints', run.all_satisfied === undefined ? undefined : run.all_satisfied ? 'all met' : 'not all met'],
+    ['strength', run.strength === undefined || run.strength === 1 ? undefined : `${fmt(run.strength)}x gains and torque limits`],
+    ['effort bound', bounds.effort === undefined ? undefined : `${fmt(bounds.effort)}x M0's effort`],
+    ['distance bound', bounds.distance === undefined ? undefined : `${fmt(bounds.distance)} from M0`],
   ];
   for (const [k, v] of facts) {
     if (v === undefined) continue;
@@ -72,7 +76,10 @@ function fillDistances() {
     const table = $('distances');
     table.replaceChildren();
     const head = el('tr');
+    const bounds = (data.run || {}).bounds || {};
+    const hasEffort = data.motions.some((m) => typeof m.effort_ratio === 'number');
     head.append(el('th', {}, ''), el('th', {}, 'C'));
+    if (hasEffort) head.append(el('th', { title: 'control effort relative to M0\'s' }, 'effort'));
     for (const l of labels) head.append(el('th', {}, l));
     table.append(head);
     const d = dist[current] || [];
@@ -81,12 +88,24 @@ function fillDistances() {
       row.append(el('th', {}, m.label));
       const c = el('td', { class: m.constraint === 0 ? 'ok' : 'bad', title: m.status }, fmt(m.constraint));
       row.append(c);
+      if (hasEffort) {
+        // Effort (time integral of the squared joint torques) as a multiple of M0's.
+        const over = bounds.effort !== undefined && m.effort_ratio > bounds.effort;
+        row.append(el('td', {
+          class: `effort${over ? ' bad' : ''}`,
+          title: `effort ${fmt(m.effort)} N²m²s, positive work ${fmt(m.positive_work)} J` +
+            (bounds.effort !== undefined ? `; bound ${fmt(bounds.effort)}x M0's` : ''),
+        }, `${fmt(m.effort_ratio)}x`));
+      }
       const others = (d[i] || []).filter((_, j) => j !== i);
       const min = Math.min(...others);
       (d[i] || []).forEach((v, j) => {
         const cell = el('td', {}, i === j ? '-' : fmt(v));
         if (i === j) cell.className = 'self';
         else if (v === min) cell.className = 'min';
+        // A distance bound holds on d(M0, Mi) in the run's own metric.
+        if (i !== j && (i === 0 || j === 0) && current === dist.objective &&
+            bounds.distance !== undefined && v > bounds.distance) cell.className += ' bad';
         row.append(cell);
       });
       table.append(row);
@@ -94,7 +113,10 @@ function fillDistances() {
     $('distance-hint').textContent =
       `d(Mi, Mj) under ${METRIC_NAMES[current] || current}` +
       (current === dist.objective ? ' (the metric the run optimized)' : '') +
-      '. In bold, each motion\'s nearest neighbour (dmin). C is the constraint penalty: 0 when the task is met.';
+      '. In bold, each motion\'s nearest neighbour (dmin). C is the constraint penalty: 0 when the task is met' +
+      ((data.run || {}).bounds && Object.keys(data.run.bounds).length ? ' and every bound is kept' : '') + '.' +
+      (hasEffort ? ' Effort: the time integral of the squared joint torques, as a multiple of M0\'s' +
+        (bounds.effort !== undefined ? ' (red: over the bound)' : '') + '.' : '');
     for (const b of $('metric-tabs').children) b.setAttribute('aria-selected', String(b.dataset.metric === current));
   };
   for (const m of metrics) {

@@ -10,7 +10,8 @@
 // and its forward kinematics (as three.js plays it) puts every joint within 1 mm of the
 // body's position in the page's data (MuJoCo's xpos). The plots panel draws D and the best
 // set's D with one point per generation of the data, C and dmin for every motion, one
-// heatmap per metric with a cell per pair. A 3D run (free root) is seen three-quarters and
+// heatmap per metric with a cell per pair. A run with bounds shows every motion's effort
+// relative to M0's, marked where over the bound, and its bounds. A 3D run (free root) is seen three-quarters and
 // its "follow" switch moves the views. Where RUN_DIR/export holds glTF files: every .glb
 // passes the Khronos glTF validator with no error, three.js's GLTFLoader reads each with a
 // node per body and its animation, and playing it puts every body within 1 mm of MuJoCo's
@@ -301,6 +302,28 @@ try {
     'one distance heatmap per metric, one cell per pair', JSON.stringify(plots.heatmaps));
   if (!plots.progressHidden) {
     await page.locator('#plots').screenshot({ path: join(runDir, 'plots-screenshot.png') });
+  }
+
+  // A run with bounds: every motion's effort relative to M0's in the distance table (marked
+  // where over the bound) and the bounds among the run's facts.
+  const bounds = data.run?.bounds || {};
+  if (Object.keys(bounds).length) {
+    const shown = await page.evaluate(() => ({
+      head: [...document.querySelectorAll('#distances tr:first-child th')].map((t) => t.textContent),
+      effort: [...document.querySelectorAll('#distances td.effort')].map((t) => ({
+        text: t.textContent, over: t.classList.contains('bad') })),
+      facts: document.getElementById('facts').textContent,
+    }));
+    check(shown.head.includes('effort') && shown.effort.length === n &&
+      shown.effort.every((e, i) => Math.abs(parseFloat(e.text) - data.motions[i].effort_ratio) <=
+        0.01 * data.motions[i].effort_ratio),
+      'the distance table shows every motion\'s effort relative to M0\'s', JSON.stringify(shown.effort));
+    check(shown.effort[0].text.startsWith('1') && shown.effort.every((e, i) =>
+      e.over === (bounds.effort !== undefined && data.motions[i].effort_ratio > bounds.effort)),
+      'efforts over the bound are marked, the others not', JSON.stringify(shown.effort));
+    check((bounds.effort === undefined || shown.facts.includes('effort bound')) &&
+      (bounds.distance === undefined || shown.facts.includes('distance bound')),
+      'the run\'s bounds are among its facts', shown.facts);
   }
 
   await page.locator('#time').fill('500');
