@@ -15,6 +15,7 @@
 
 #include "io/files.h"
 #include "support/cli.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -29,8 +30,7 @@ struct Case {
 };
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_bad_input_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("bad_input_" + name);
   fs::create_directories(dir);
   return dir;
 }

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "physics/model.h"
 #include "support/stance_run.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -129,7 +130,7 @@ TEST(BvhExport, PlanarHumanRoundTripsAndMatchesMujoco) {
   EXPECT_EQ(bvh.joints[static_cast<std::size_t>(bvh.find("head"))].has_end_site, true);
 
   // Written and parsed back: same skeleton, frames within the 6 printed decimals.
-  const fs::path file = fs::temp_directory_path() / "diverse_bvh_test" / "human.bvh";
+  const fs::path file = test_files::scratch_dir("bvh_test") / "human.bvh";
   write_bvh(file, bvh);
   const Bvh back = read_bvh(file);
   ASSERT_EQ(back.joints.size(), bvh.joints.size());

@@ -9,14 +9,14 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_files_test_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("files_test_" + name);
   return dir;
 }
 

@@ -13,6 +13,7 @@
 #include "io/files.h"
 #include "run/blend.h"
 #include "support/cli.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -22,8 +23,7 @@ using cli_test::CliResult;
 using cli_test::run_cli;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_blend_test_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("blend_test_" + name);
   return dir;
 }
 

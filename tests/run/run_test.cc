@@ -17,6 +17,7 @@
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "run/run.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -26,8 +27,7 @@ using Result = cli_test::CliResult;
 using cli_test::run_cli;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_run_test_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("run_test_" + name);
   return dir;
 }
 

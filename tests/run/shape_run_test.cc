@@ -19,6 +19,7 @@
 #include "support/cli.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -28,8 +29,7 @@ using cli_test::CliResult;
 using cli_test::run_cli;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_shape_run_test_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("shape_run_test_" + name);
   return dir;
 }
 

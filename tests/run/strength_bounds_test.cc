@@ -18,6 +18,7 @@
 #include "support/cli.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -29,8 +30,7 @@ const std::string kSource = DIVERSE_SOURCE_DIR;
 const std::string kTask = kSource + "/tasks/jump_high.toml";
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_strength_bounds_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("strength_bounds_" + name);
   return dir;
 }
 

@@ -9,6 +9,7 @@
 
 #include "io/files.h"
 #include "support/cli.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -33,8 +34,7 @@ fs::path write_forward_task(const fs::path& dir, const std::string& name, const 
 }
 
 TEST(SeedMotionCli, AShortSearchThatFailsWritesAPartialFileNotTheM0) {
-  const fs::path dir = fs::temp_directory_path() / "diverse_seed_motion_cli_test";
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("seed_motion_cli_test_partial");
   fs::create_directories(dir);
   // Starting from the hand-authored small in-place jump, which one generation of search
   // cannot turn into a 1 m forward jump.

@@ -9,6 +9,7 @@
 
 #include "support/cli.h"
 #include "task/evaluate.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -23,8 +24,7 @@ TEST(SimulateCli, PhasesNeverReachedAreSaidToBe) {
   for (int i = 0; i < lowest.size(); ++i) {
     j["parameters"][lowest.specs()[static_cast<size_t>(i)].name] = lowest.values()[static_cast<size_t>(i)];
   }
-  const auto dir = std::filesystem::temp_directory_path() / "diverse_simulate_cli_test";
-  std::filesystem::remove_all(dir);
+  const auto dir = test_files::scratch_dir("simulate_cli_test");
   std::filesystem::create_directories(dir);
   const auto params = dir / "lowest.json";
   std::ofstream(params) << j.dump(1);

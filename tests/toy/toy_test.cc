@@ -17,6 +17,7 @@
 
 #include "core/thread_pool.h"
 #include "optimize/diversity.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -190,8 +191,7 @@ using Command = cli_test::CliResult;
 Command run(const std::string& args) { return cli_test::run_cli(args); }
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("diverse_toy_test_" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test_files::scratch_dir("toy_test_" + name);
   return dir;
 }
 
