@@ -33,13 +33,7 @@ double yaw_of(const mjData* d, int b) {
 
 }  // namespace
 
-WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Character& body, const TaskWalk& walk) {
-  WalkAudit a;
-  mjModel* m = mj_copyModel(nullptr, model);
-  mjData* d = mj_makeData(m);
-
-  // Standing: the model's qpos0.
-  mj_kinematics(m, d);
+int walk_torso(const Character& body) {
   int torso = -1;
   size_t depth = 0;
   for (size_t k = 0; k < body.joints.size(); ++k) {
@@ -51,6 +45,17 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
       depth = dd;
     }
   }
+  return torso;
+}
+
+WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Character& body, const TaskWalk& walk) {
+  WalkAudit a;
+  mjModel* m = mj_copyModel(nullptr, model);
+  mjData* d = mj_makeData(m);
+
+  // Standing: the model's qpos0.
+  mj_kinematics(m, d);
+  const int torso = walk_torso(body);
   const std::array<double, 3> root_up = standing_up(d, body.root_body);
   const std::array<double, 3> torso_up = torso >= 0 ? standing_up(d, torso) : root_up;
   const double standing_yaw = yaw_of(d, body.root_body);

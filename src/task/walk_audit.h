@@ -59,6 +59,11 @@ struct WalkAudit {
 // Landings closer than this after a foot left the ground are contact chatter (s).
 inline constexpr double kMinAirTime = 0.05;
 
+// The body a walk keeps upright besides the root: the child of the deepest centre waist
+// hinge, or -1 if the character has none. The task's observer (task/walk_eval.h) and the
+// audit use the same one.
+int walk_torso(const Character& body);
+
 // `m` is the motion's saved model (not modified), `record` its replay record, `body` the
 // character bound to `m`.
 WalkAudit audit_walk(const mjModel* m, const StepRecorder& record, const Character& body, const TaskWalk& walk);

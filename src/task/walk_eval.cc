@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "control/walk_controller.h"
+#include "task/walk_audit.h"
 
 namespace diverse {
 namespace {
@@ -37,17 +38,7 @@ WalkObserver::WalkObserver(const Task& task, const Character& body, const mjMode
   nq_ = m->nq;
   const auto standing = standing_orientations(m);
   root_up_ = up_in(standing[static_cast<size_t>(body.root_body)]);
-  // The torso: the body of the deepest centre waist hinge, if any.
-  size_t depth = 0;
-  for (size_t k = 0; k < body.joints.size(); ++k) {
-    const CharacterJoint& j = body.joints[k];
-    if (body.groups[static_cast<size_t>(j.group)].role != JointRole::kWaist || j.side != Side::kCenter) continue;
-    const size_t dd = body.chain(static_cast<int>(k)).size();
-    if (torso_ < 0 || dd > depth) {
-      torso_ = j.body;
-      depth = dd;
-    }
-  }
+  torso_ = walk_torso(body);
   if (torso_ >= 0) torso_up_ = up_in(standing[static_cast<size_t>(torso_)]);
   double R[9];
   mju_quat2Mat(R, standing[static_cast<size_t>(body.root_body)].data());
