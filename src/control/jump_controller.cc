@@ -106,12 +106,14 @@ std::shared_ptr<const ControllerConfig> JumpControllerConfig::with_landing_heigh
 // The plug-in.
 
 std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const TomlReader& r) const {
-  r.only({"type", "landing_control", "landing_height", "extend_timeout", "balance_kp",
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation"});
   auto c = std::make_shared<JumpControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
   c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
+  c->tuck_time = r.number("tuck_time", 0, 1, c->tuck_time);
+  c->open_time = r.number("open_time", 0, 1, c->open_time);
   c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
@@ -272,9 +274,11 @@ void JumpController::enter(int phase, double time) {
     case kRise:
       takeoff_com_z_ = com_[2];
       phase_duration_ = std::max(com_vel_[2], 0.05) / gravity_;
+      if (config_.tuck_time > 0) phase_duration_ = std::min(phase_duration_, config_.tuck_time);
       break;
     case kFall:
       phase_duration_ = std::sqrt(2 * std::max(com_[2] - takeoff_com_z_, 0.01) / gravity_);
+      if (config_.open_time > 0) phase_duration_ = std::min(phase_duration_, config_.open_time);
       break;
     case kLand: phase_duration_ = land_duration_; break;
     default: phase_duration_ = start_duration_; break;

@@ -9,10 +9,10 @@
 //           ends when the character is airborne (no contact with anything for
 //           airborne_time, COM rising)
 //   rise    flight, ends at peak height (COM vertical velocity <= 0); duration predicted
-//           as v_z / g at take-off
+//           as v_z / g at take-off (targets reached sooner with the config's tuck_time)
 //   fall    flight, ends at the first contact; duration predicted as the ballistic time
-//           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g); optional landing
-//           controller (below)
+//           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g) (targets reached
+//           sooner with the config's open_time); optional landing controller (below)
 //   land    stance, balance, targets interpolated over land.duration, then held
 //
 // The character (character/character.h) needs a planar root and joint groups with the
@@ -80,6 +80,12 @@ struct JumpControllerConfig : ControllerConfig {
   double landing_height_m = 0;       // m, height of the surface the COM prediction uses
   double extend_timeout = 0.8;       // s; an extend that never leaves the ground ends here
   double airborne_time = 0.01;       // s without contact (COM rising) that counts as take-off
+  // s; > 0: the rise phase reaches its targets this long after take-off instead of at the
+  // predicted peak (a quick tuck turns a backflip faster); 0 = over the whole rise.
+  double tuck_time = 0;
+  // s; > 0: the fall phase reaches its targets this long after the peak instead of at the
+  // predicted touch-down (opening out of a tuck in time to land); 0 = over the whole fall.
+  double open_time = 0;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }

@@ -7,7 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 #include "character/character.h"
 #include "physics/drive.h"
@@ -15,6 +18,7 @@
 #include "core/error.h"
 #include "physics/model.h"
 #include "task/evaluate.h"
+#include "support/scratch.h"
 
 namespace diverse {
 namespace {
@@ -135,6 +139,90 @@ TEST(JumpController, PhasesInOrderTorquesWithinLimits) {
   mj_deleteModel(plain);
   EXPECT_EQ(check.steps, record.steps());
   EXPECT_LE(check.worst_excess, 1e-9);
+}
+
+
+// The backflip task with lines added to its [controller] table, written to a scratch
+// directory (with the files it names).
+std::string backflip_with(const std::string& name, const std::string& controller_lines) {
+  std::ifstream in(kRoot + "/tasks/backflip.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string toml = text.str();
+  const std::string key = "type = \"jump2d\"\n";
+  const std::string character = "../assets/characters/human2d.toml";
+  if (toml.find(key) == std::string::npos || toml.find(character) == std::string::npos) return "";
+  toml.replace(toml.find(key), key.size(), key + controller_lines);
+  toml.replace(toml.find(character), character.size(), kRoot + "/assets/characters/human2d.toml");
+  const std::filesystem::path dir = test_files::scratch_dir(name);
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"backflip.m0.json", "backflip_start.json"})
+    std::filesystem::copy_file(kRoot + "/tasks/" + f, dir / f);
+  std::ofstream(dir / "backflip.toml") << toml;
+  return (dir / "backflip.toml").string();
+}
+
+struct Recorded {
+  Evaluation e;
+  StepRecorder record;
+  ParameterSet p;
+  // qpos of joint `name` at time t (s) of the recorded rollout.
+  double joint_at(const TaskEvaluator& ev, const char* name, double t) const {
+    const int j = mj_name2id(ev.model().get(), mjOBJ_JOINT, name);
+    const int step = static_cast<int>(std::lround(t / record.timestep));
+    return record.qpos[static_cast<size_t>(step * record.nq + ev.model().get()->jnt_qposadr[j])];
+  }
+};
+
+Recorded simulate_m0(const std::string& task_file) {
+  const TaskEvaluator ev(load_task(task_file));
+  Recorded r{{}, {}, ev.load_parameters(ev.task().m0)};
+  auto worker = ev.make_worker();
+  EvaluationOptions options;
+  options.recorder = &r.record;
+  r.e = ev.evaluate(r.p.values(), *worker, options);
+  return r;
+}
+
+// The first `seconds` of two recorded rollouts are the same to the bit.
+void expect_same_until(const Recorded& a, const Recorded& b, double seconds) {
+  const int steps = static_cast<int>(std::lround(seconds / a.record.timestep));
+  ASSERT_GE(a.record.steps(), steps);
+  ASSERT_GE(b.record.steps(), steps);
+  for (int k = 0; k < steps * a.record.nq; ++k)
+    ASSERT_EQ(a.record.qpos[static_cast<size_t>(k)], b.record.qpos[static_cast<size_t>(k)]) << "step " << k / a.record.nq;
+}
+
+// [controller] tuck_time: the rise phase reaches its targets that long after take-off
+// instead of at the predicted peak; open_time: the fall phase reaches its targets that
+// long after the peak instead of at the predicted touch-down. Before the phase they change
+// the motion is the same to the bit; soon after, the knees are much nearer the phase's
+// target.
+TEST(JumpController, TuckAndOpenTimesReachTheFlightTargetsSoonerAndChangeNothingBefore) {
+  const std::string tuck_file = backflip_with("tuck_time", "tuck_time = 0.08\n");
+  const std::string open_file = backflip_with("open_time", "tuck_time = 0.08\nopen_time = 0.1\n");
+  ASSERT_FALSE(tuck_file.empty());
+  const TaskEvaluator ev(load_task(kRoot + "/tasks/backflip.toml"));
+  const Recorded plain = simulate_m0(kRoot + "/tasks/backflip.toml");
+  const Recorded tuck = simulate_m0(tuck_file);
+  const Recorded open = simulate_m0(open_file);
+  for (const Recorded* r : {&plain, &tuck, &open}) ASSERT_FALSE(r->e.failed);
+
+  const double takeoff = plain.e.phases.takeoff();
+  EXPECT_EQ(tuck.e.phases.takeoff(), takeoff);
+  expect_same_until(plain, tuck, takeoff);
+  const double rise_knee = plain.p.get("rise.knee");
+  const double t = takeoff + 0.12;
+  EXPECT_LT(std::fabs(tuck.joint_at(ev, "knee_l", t) - rise_knee),
+            0.5 * std::fabs(plain.joint_at(ev, "knee_l", t) - rise_knee));
+
+  const double peak = tuck.e.phases.peak();
+  EXPECT_EQ(open.e.phases.peak(), peak);
+  expect_same_until(tuck, open, peak);
+  const double fall_knee = plain.p.get("fall.knee");
+  const double u = peak + 0.2;  // the knee follows its target with a lag
+  EXPECT_LT(std::fabs(open.joint_at(ev, "knee_l", u) - fall_knee),
+            0.5 * std::fabs(tuck.joint_at(ev, "knee_l", u) - fall_knee));
 }
 
 }  // namespace

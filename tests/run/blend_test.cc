@@ -29,10 +29,13 @@ fs::path scratch(const std::string& name) {
 
 std::string task(const std::string& name) { return std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + name + ".toml"; }
 
-// A short but real run of the high jump: 2 variations, 3 generations of 8 samples.
-fs::path short_run(const std::string& name, const std::string& extra = "") {
+// A short but real run of the high jump: 2 variations, 3 generations of 8 samples (a
+// shaped run: 5 generations from a step of 0.01, as in shape_run_test.cc, else under the
+// half-timestep check a variation can still stand at M0's body).
+fs::path short_run(const std::string& name, const std::string& extra = "",
+                   const std::string& schedule = "--sigma0 0.03 --generations 3") {
   const fs::path dir = scratch(name);
-  const CliResult r = run_cli("run " + task("jump_high") + " --n 2 --popsize 8 --sigma0 0.03 --generations 3 --seed 3 " +
+  const CliResult r = run_cli("run " + task("jump_high") + " --n 2 --popsize 8 " + schedule + " --seed 3 " +
                               "--quiet --no-render --threads 2 " + extra + " --out " + dir.string());
   EXPECT_EQ(r.status, 0) << r.output;
   return dir;
@@ -174,7 +177,7 @@ TEST(Blend, ControlRunBlendsReplayExactlyAndDoNotDependOnThreads) {
 }
 
 TEST(Blend, ShapedRunBlendsTheBodiesToo) {
-  const fs::path dir = short_run("shape", "--vary shape --metric md+shape");
+  const fs::path dir = short_run("shape", "--vary shape --metric md+shape", "--sigma0 0.01 --generations 5");
   const CliResult r = run_cli("blend " + dir.string() + " --samples 3 --path-points 1 --threads 2");
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json s = read_json(dir / "blend" / "summary.json");
