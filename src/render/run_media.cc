@@ -106,6 +106,14 @@ std::string time_stamp(double t) {
 
 }  // namespace
 
+std::string fitting_title(const std::vector<std::string>& titles, const std::string& stamp, int width, int gap) {
+  if (titles.empty()) return "";
+  const int room = width - 3 * gap - text_width(stamp, FontSize::kMedium);
+  for (const std::string& title : titles)
+    if (text_width(title, FontSize::kMedium) <= room) return title;
+  return titles.back();
+}
+
 double RunMotion::duration() const { return record.steps() * record.timestep; }
 
 std::vector<double> RunMotion::qpos_at(double t) const {
@@ -263,6 +271,16 @@ std::vector<fs::path> write_run_videos(const RunView& run, const RunVideoOptions
   all_title.append(", metric ").append(run.metric).append(", ").append(std::to_string(n));
   all_title.append(" motions");
   if (!speed_note.empty()) all_title.append(", ").append(speed_note);
+  // Each header chosen once, to fit beside the motion's last (widest) time stamp.
+  const std::string note = speed_note.empty() ? "" : ", " + speed_note;
+  const std::string last_stamp = time_stamp(static_cast<double>(length) * speed / options.fps);
+  all_title = fitting_title({all_title, run.task_name + note, run.task_name}, last_stamp, all_w, gap);
+  std::vector<std::string> single_titles;
+  for (std::size_t k = 0; k < run.motions.size(); ++k) {
+    const std::string& label = run.motions[k].label;
+    const std::string stamp = time_stamp(static_cast<double>(frames[k].size()) * speed / options.fps);
+    single_titles.push_back(fitting_title({run.task_name + " " + label + note, label + note, label}, stamp, one_w, gap));
+  }
   Image canvas(all_w, all_h, kBackground);
   Image single(one_w, one_h, kBackground);
   std::vector<Image> last(run.motions.size());  // a finished motion holds its last tile
@@ -278,10 +296,7 @@ std::vector<fs::path> write_run_videos(const RunView& run, const RunVideoOptions
         last[k] = renderers[k]->render(frames[k][t], plan.follow ? at_anchor(camera, anchors[k][t]) : camera);
         label_tile(last[k], m, t + 1 == frames[k].size() ? "end" : "");
         single.fill(kBackground);
-        std::string title = run.task_name;
-        title.append(" ").append(m.label);
-        if (!speed_note.empty()) title.append(", ").append(speed_note);
-        draw_text(single, title, gap, gap, kText, FontSize::kMedium);
+        draw_text(single, single_titles[k], gap, gap, kText, FontSize::kMedium);
         draw_text(single, stamp, one_w - gap, gap, kText, FontSize::kMedium, Align::kRight);
         single.paste(last[k], gap, header_h + gap);
         writers[k]->add_frame(single);

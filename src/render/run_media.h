@@ -58,6 +58,12 @@ struct RunMotion {
   std::string status() const;
 };
 
+// A video's header line holds a title on the left and the time stamp on the right: the
+// first of `titles` that leaves `stamp` room (FontSize::kMedium, margins of `gap` pixels)
+// in `width` pixels, else the last. Longest first: "robot_silly_walk M1, real time", then
+// "M1, real time", then "M1".
+std::string fitting_title(const std::vector<std::string>& titles, const std::string& stamp, int width, int gap);
+
 // Reads one motion file (io/motion_record.h) with its model and phases, labelled `label`;
 // the caller fills in index, constraint, dmin, fell and failed. Throws UserError on a
 // missing or malformed file: "FILE: missing; <remedy>" for a missing motion or model file.

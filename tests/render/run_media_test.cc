@@ -422,3 +422,25 @@ TEST_F(RunMediaTest, CommandsOnWhatIsNotAFinishedRunAreOneLineErrors) {
 
 }  // namespace
 }  // namespace diverse
+
+namespace diverse {
+namespace {
+
+// A single motion's video header: its title and the time stamp never overlap. The bird
+// robot's walk ("robot_silly_walk M1, real time" beside "t = 11.70 s") did not fit in
+// one 384-pixel tile and was drawn over the stamp; the shorter "M1, real time" does.
+TEST(RunMedia, VideoTitlesLeaveRoomForTheTimeStamp) {
+  const int gap = 6, width = 384 + 2 * gap;
+  const std::string stamp = "t = 11.70 s";
+  const std::vector<std::string> titles = {"robot_silly_walk M1, real time", "M1, real time", "M1"};
+  EXPECT_GT(text_width(titles[0], FontSize::kMedium) + text_width(stamp, FontSize::kMedium) + 3 * gap, width);
+  const std::string title = fitting_title(titles, stamp, width, gap);
+  EXPECT_EQ(title, "M1, real time");
+  EXPECT_LE(text_width(title, FontSize::kMedium) + text_width(stamp, FontSize::kMedium) + 3 * gap, width);
+  EXPECT_EQ(fitting_title(titles, stamp, 2000, gap), titles[0]);  // room for the whole title
+  EXPECT_EQ(fitting_title(titles, stamp, 100, gap), "M1");         // nothing fits: the shortest
+  EXPECT_EQ(fitting_title({}, stamp, width, gap), "");
+}
+
+}  // namespace
+}  // namespace diverse
