@@ -63,7 +63,6 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
   const int steps = std::min(record.steps(), static_cast<int>(record.qpos.size()) / std::max(1, record.nq));
   std::array<bool, 2> down{true, true};
   std::array<double, 2> lifted{0, 0};           // time each foot last left the ground
-  std::array<std::array<double, 2>, 2> planted{};  // where each foot was when it last landed
   int last_leg = -1;
   double airborne_since = -1;
   double heading = 0, start_heading = 0, last_yaw = 0, tilt = 0;
@@ -79,10 +78,6 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
     const double yaw = yaw_of(d, body.root_body) - standing_yaw;
     if (first) {
       heading = start_heading = yaw;
-      for (int f = 0; f < 2; ++f) {
-        const double* p = d->xpos + 3 * body.feet[static_cast<size_t>(f)];
-        planted[static_cast<size_t>(f)] = {p[0], p[1]};
-      }
       first = false;
     } else {
       heading += std::remainder(yaw - last_yaw, 2 * M_PI);
@@ -123,7 +118,7 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
         if (f == last_leg) {
           ++a.relandings;
         } else {
-          const std::array<double, 2>& from = planted[1 - i];
+          const double* from = d->xpos + 3 * body.feet[1 - i];  // the other foot, now
           const double dx = p[0] - from[0], dy = p[1] - from[1];
           WalkAudit::Step step;
           step.leg = f;
@@ -137,7 +132,6 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
           tilt = 0;
           last_leg = f;
         }
-        planted[i] = {p[0], p[1]};
       }
       down[i] = now[i];
     }

@@ -104,9 +104,6 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
   if (first_) {
     heading_ = raw;
     walk.start_heading = raw;
-    const int stance = 1 - swing_leg(kLeftLift);
-    const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(stance)];
-    last_foot_ = {f[0], f[1]};
     state_ = controller_.phase();
     first_ = false;
   } else {
@@ -132,8 +129,12 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
       // A strike state ended: a touch-down, or a swing foot that never came down.
       const int leg = swing_leg(ended);
       if (!contacts_.foot[static_cast<size_t>(leg)]) return fall(d, "the swing foot did not come down");
+      // The step: from the other foot, where it is now, to the landing foot. (Not from
+      // where the other foot landed: a foot that slides or shuffles back after landing
+      // would let short or backward steps count as long ones.)
       const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(leg)];
-      const double dx = f[0] - last_foot_[0], dy = f[1] - last_foot_[1];
+      const double* o = d->xpos + 3 * body_.feet[static_cast<size_t>(1 - leg)];
+      const double dx = f[0] - o[0], dy = f[1] - o[1];
       const double h = raw;
       WalkStep step;
       step.leg = leg;
@@ -144,7 +145,6 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
       step.tilt = tilt_;
       walk.steps.push_back(step);
       tilt_ = 0;
-      last_foot_ = {f[0], f[1]};
       if (state == kLeftLift) stride_heading_ = raw;  // a stride begins
       const int taken = static_cast<int>(walk.steps.size());
       if (taken >= w.steps) {

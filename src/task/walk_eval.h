@@ -63,7 +63,6 @@ class WalkObserver : public StepHooks {
   std::array<double, 3> root_up_{0, 0, 1}, torso_up_{0, 0, 1};  // standing "up" in each body's frame
   double standing_heading_ = 0;
   double heading_ = 0, last_raw_heading_ = 0;  // unwrapped
-  std::array<double, 2> last_foot_{};   // where the previous stance foot is (m, x y)
   double tilt_ = 0;                     // rad, largest since the last step
   double flight_start_ = -1;            // s, when both feet last left the ground; -1 if one is down
   int nq_ = 0;

@@ -17,9 +17,10 @@
 // A step is a touch-down of the swing foot that ends a strike state (the controller's
 // phase changes from a strike state to the next lift state with the swing foot in
 // contact). Its length is where the new stance foot is (its body origin: the human's
-// ankle, the robot's toe joint) minus where the previous stance foot was, in the heading
-// frame at the touch-down: forward along the root's forward axis turned onto the ground,
-// lateral to its left. The first step is measured from the stance foot of the start.
+// ankle, the robot's toe joint) minus where the other foot is at that moment, in the
+// heading frame at the touch-down: forward along the root's forward axis turned onto the
+// ground, lateral to its left. (Measured from where the other foot landed instead, a foot
+// that slid or shuffled back after landing let backward steps count as long ones.)
 //
 // Drift and turns. Step lengths are measured in the walker's own heading frame, so a
 // walk that curves gently is judged by its steps, not by where it heads; a walk that

@@ -16,6 +16,7 @@
 #include "task/constraints.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "task/walk_audit.h"
 #include "task/walk_task.h"
 
 namespace diverse {
@@ -229,6 +230,39 @@ TEST(WalkEvaluation, AHopIsAFall) {
   EXPECT_EQ(e.summary.fall_reason, "both feet were off the ground for longer than max_flight (a hop, not a walk)");
   EXPECT_LT(e.summary.walk.steps.size(), 2u);
   EXPECT_NEAR(e.report.terms.front().penalty, 50000.0 * (1 - e.summary.walk.steps.size() / 30.0), 1e-6);
+}
+
+// A step is measured from where the other foot is at the touch-down. A human walk that a
+// run found under the earlier rule (from where the other foot had landed) moves its feet
+// after they land: measured from the landing spots its steps met the 0.5 m minimum (C = 0);
+// between the feet at each touch-down they are about 0.46 m, and it breaks the task. (The
+// walk audit, counting steps from foot contacts, finds most of them going backward.)
+TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
+  const TaskEvaluator ev(load_task(kTasks + "silly_walk.toml"));
+  const ParameterSet p =
+      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/human_walk_slides_back.json");
+  const auto worker = ev.make_worker();
+  const Evaluation e = ev.evaluate(p.values(), *worker);
+  ASSERT_FALSE(e.fell) << e.summary.fall_reason;
+  const auto& steps = e.summary.walk.steps;
+  ASSERT_EQ(steps.size(), 30u);
+  const double shortest = ev.task().walk.forward_center - ev.task().walk.forward_half_width;
+  for (std::size_t i = 10; i < steps.size(); ++i) {
+    EXPECT_LT(steps[i].forward, shortest) << "step " << i + 1;
+    EXPECT_GT(steps[i].forward, 0.4) << "step " << i + 1;
+  }
+  double step_forward = 0;
+  for (const auto& term : e.report.terms)
+    if (term.name == "step_forward") step_forward = term.penalty;
+  EXPECT_GT(step_forward, 0);
+  EXPECT_GT(e.report.total, 0);
+  // The independent audit of the same walk fails it too.
+  StepRecorder record;
+  EvaluationOptions options;
+  options.recorder = &record;
+  ev.evaluate(p.values(), *worker, options);
+  const WalkAudit a = audit_walk(ev.model().get(), record, ev.body(), ev.task().walk);
+  EXPECT_FALSE(a.violations.empty());
 }
 
 TEST(WalkEvaluation, FallEndsTheRollout) {
