@@ -40,6 +40,25 @@ struct SeedArgs {
   double strength = 1.0;
 };
 
+// The options that change what is searched for (not how long or from where), as they
+// must be given again to go on from a partial result or a stage: strength, flight
+// rotation and the robustness term.
+std::string searched_options(const SeedArgs& args) {
+  auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%g", v);
+    return std::string(text);
+  };
+  std::string options;
+  if (args.strength != 1.0) options += " --strength " + number(args.strength);
+  if (args.min_flight_rotation_deg > 0) options += " --min-flight-rotation " + number(args.min_flight_rotation_deg);
+  if (args.perturbations > 0) {
+    options += " --perturbations " + std::to_string(args.perturbations) + " --perturbation-sigma " +
+               number(args.perturbation_sigma);
+  }
+  return options;
+}
+
 // The task at the strength asked for (Task::strength).
 Task task_at_strength(const SeedArgs& args) {
   Task task = load_task(resolve_task_path(args.task));
@@ -107,7 +126,8 @@ void run(const SeedArgs& args) {
     j["stage_value"] = value;
     j["constraint"] = constraint;
     j["continue_with"] = "diverse seed-motion " + args.task + " --start " + stem + ".stage" +
-                         std::to_string(stage) + ".json --from-stage " + std::to_string(stage + 1);
+                         std::to_string(stage) + ".json" + searched_options(args) + " --from-stage " +
+                         std::to_string(stage + 1);
     j["parameters"] = p.to_json();
     const std::string path = stem + ".stage" + std::to_string(stage) + ".json";
     write_json_atomic(path, j);
@@ -131,23 +151,8 @@ void run(const SeedArgs& args) {
     std::snprintf(sigma, sizeof(sigma), "%g", args.sigma);
     command += std::string(" --sigma ") + sigma;
   }
-  if (args.perturbations > 0) {
-    char sigma[32];
-    std::snprintf(sigma, sizeof(sigma), "%g", args.perturbation_sigma);
-    command += " --perturbations " + std::to_string(args.perturbations) +
-               " --perturbation-sigma " + sigma;
-  }
+  command += searched_options(args);
   if (args.from_stage > 0) command += " --from-stage " + std::to_string(args.from_stage);
-  if (args.strength != 1.0) {
-    char strength[32];
-    std::snprintf(strength, sizeof(strength), "%g", args.strength);
-    command += std::string(" --strength ") + strength;
-  }
-  if (args.min_flight_rotation_deg > 0) {
-    char deg[32];
-    std::snprintf(deg, sizeof(deg), "%g", args.min_flight_rotation_deg);
-    command += std::string(" --min-flight-rotation ") + deg;
-  }
   command += " (" + std::to_string(r.evaluations) + " rollouts)";
   auto write = [&](const std::string& path, const ParameterSet& p, double constraint) {
     nlohmann::json j;
@@ -177,7 +182,7 @@ void run(const SeedArgs& args) {
   if (!met)
     throw UserError(task.file + ": no motion meeting the task was found (best C = " +
                     std::to_string(r.constraint) + "); continue with `diverse seed-motion " +
-                    args.task + " --start " + out + "`");
+                    args.task + " --start " + out + searched_options(args) + "`");
 }
 
 void install(CLI::App& app) {

@@ -106,7 +106,8 @@ std::shared_ptr<const ControllerConfig> JumpControllerConfig::with_landing_heigh
 // The plug-in.
 
 std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const TomlReader& r) const {
-  r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "balance_kp",
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
+          "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation"});
   auto c = std::make_shared<JumpControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
@@ -114,6 +115,8 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
   c->tuck_time = r.number("tuck_time", 0, 1, c->tuck_time);
   c->open_time = r.number("open_time", 0, 1, c->open_time);
+  // Degrees in the file, like the rotation constraints; radians inside.
+  c->open_rotation = r.number("open_rotation", 0, 720, c->open_rotation * 180 / M_PI) * M_PI / 180;
   c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
@@ -273,11 +276,19 @@ void JumpController::enter(int phase, double time) {
     case kExtend: phase_duration_ = 1e-9; break;
     case kRise:
       takeoff_com_z_ = com_[2];
+      takeoff_pitch_ = q_[body_.root_pitch_qpos];
       phase_duration_ = std::max(com_vel_[2], 0.05) / gravity_;
       if (config_.tuck_time > 0) phase_duration_ = std::min(phase_duration_, config_.tuck_time);
       break;
     case kFall:
-      phase_duration_ = std::sqrt(2 * std::max(com_[2] - takeoff_com_z_, 0.01) / gravity_);
+      if (config_.open_rotation > 0) {
+        // Possibly past the peak: the time back to take-off height from here.
+        const double down = std::max(-com_vel_[2], 0.0);
+        const double above = std::max(com_[2] - takeoff_com_z_, 0.01);
+        phase_duration_ = (std::sqrt(down * down + 2 * gravity_ * above) - down) / gravity_;
+      } else {
+        phase_duration_ = std::sqrt(2 * std::max(com_[2] - takeoff_com_z_, 0.01) / gravity_);
+      }
       if (config_.open_time > 0) phase_duration_ = std::min(phase_duration_, config_.open_time);
       break;
     case kLand: phase_duration_ = land_duration_; break;
@@ -372,7 +383,8 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
         // coincide, a zero-length fall, so every jump has both airborne phases.
         times_.begin[kFall] = t;
         enter(kLand, t);
-      } else if (com_vel_[2] <= 0) {
+      } else if (com_vel_[2] <= 0 &&
+                 std::fabs(q[body_.root_pitch_qpos] - takeoff_pitch_) >= config_.open_rotation) {
         enter(kFall, t);
       }
       break;

@@ -8,11 +8,13 @@
 //   extend  stance, targets applied at once (no interpolation) to build momentum,
 //           ends when the character is airborne (no contact with anything for
 //           airborne_time, COM rising)
-//   rise    flight, ends at peak height (COM vertical velocity <= 0); duration predicted
-//           as v_z / g at take-off (targets reached sooner with the config's tuck_time)
+//   rise    flight, ends at peak height (COM vertical velocity <= 0), or with the config's
+//           open_rotation once the root has also turned that far since take-off; duration
+//           predicted as v_z / g at take-off (targets reached sooner with tuck_time)
 //   fall    flight, ends at the first contact; duration predicted as the ballistic time
-//           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g) (targets reached
-//           sooner with the config's open_time); optional landing controller (below)
+//           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g) from the peak (from
+//           the current height and fall speed when open_rotation ends the rise later;
+//           targets reached sooner with open_time); optional landing controller (below)
 //   land    stance, balance, targets interpolated over land.duration, then held
 //
 // The character (character/character.h) needs a planar root and joint groups with the
@@ -86,6 +88,10 @@ struct JumpControllerConfig : ControllerConfig {
   // s; > 0: the fall phase reaches its targets this long after the peak instead of at the
   // predicted touch-down (opening out of a tuck in time to land); 0 = over the whole fall.
   double open_time = 0;
+  // rad; > 0: the rise phase (a tuck) lasts past the peak until the root has turned this
+  // far since take-off, so a flip opens for its landing when it has come round, as a
+  // gymnast opens when the floor comes into view; 0 = the fall phase begins at the peak.
+  double open_rotation = 0;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -157,6 +163,7 @@ class JumpController : public Controller {
   bool extend_timed_out_ = false;
   double phase_begin_ = 0, phase_duration_ = 1;
   double takeoff_com_z_ = 0;
+  double takeoff_pitch_ = 0;  // root pitch at take-off (rad, unwrapped)
   double free_since_ = -1;  // time contact was last lost during extend (s), -1 if touching
   PhaseTimes times_;
   // Per joint: target at the start of the phase (rad); in stance phases the world pitch

@@ -225,5 +225,34 @@ TEST(JumpController, TuckAndOpenTimesReachTheFlightTargetsSoonerAndChangeNothing
             0.5 * std::fabs(tuck.joint_at(ev, "knee_l", u) - fall_knee));
 }
 
+
+// [controller] open_rotation: the rise phase (the tuck) lasts past the peak until the root
+// has turned that far since take-off; only then does the fall phase (opening for the
+// landing) begin. Up to the peak nothing changes; the flip turns further in the air.
+TEST(JumpController, OpenRotationHoldsTheTuckUntilTheRootHasComeRound) {
+  const std::string tuck_file = backflip_with("open_rotation_tuck", "tuck_time = 0.08\n");
+  const std::string late_file = backflip_with("open_rotation", "tuck_time = 0.08\nopen_rotation = 200\n");
+  ASSERT_FALSE(tuck_file.empty());
+  const TaskEvaluator ev(load_task(late_file));
+  const Recorded tuck = simulate_m0(tuck_file);
+  const Recorded late = simulate_m0(late_file);
+  ASSERT_FALSE(tuck.e.failed);
+  ASSERT_FALSE(late.e.failed);
+
+  const double takeoff = tuck.e.phases.takeoff();
+  const double peak = tuck.e.phases.peak();
+  EXPECT_EQ(late.e.phases.takeoff(), takeoff);
+  expect_same_until(tuck, late, peak);
+  // Opened after the peak, when the root had turned 200 degrees from take-off (within
+  // the degree or so it turns in a step).
+  const double opened = late.e.phases.peak();
+  EXPECT_GT(opened, peak + 0.02);
+  const double pitch0 = late.joint_at(ev, "rooty", takeoff);
+  const double turned = std::fabs(late.joint_at(ev, "rooty", opened) - pitch0) * 180 / M_PI;
+  EXPECT_NEAR(turned, 200.0, 2.0);
+  // Held tucked longer, it turns further before its feet come down.
+  EXPECT_GT(std::fabs(late.e.summary.rotation_flight), std::fabs(tuck.e.summary.rotation_flight) + 0.2);
+}
+
 }  // namespace
 }  // namespace diverse

@@ -39,13 +39,14 @@ TEST(SeedMotionCli, AShortSearchThatFailsWritesAPartialFileNotTheM0) {
   // Starting from the hand-authored small in-place jump, which one generation of search
   // cannot turn into a 1 m forward jump.
   write_forward_task(dir, "short", "tasks/base_jump.json");
-  const auto r = cli_test::run_cli("seed-motion " + (dir / "short.toml").string() + " --threads 2");
+  // At strength 2: the hint to go on must say so again, or it would search another problem.
+  const auto r = cli_test::run_cli("seed-motion " + (dir / "short.toml").string() + " --threads 2 --strength 2");
   EXPECT_NE(r.status, 0) << r.output;
   EXPECT_FALSE(fs::exists(dir / "short.m0.json"));
   ASSERT_TRUE(fs::exists(dir / "short.partial.json")) << r.output;
   EXPECT_GT(read_json(dir / "short.partial.json")["constraint"].get<double>(), 0.0);
   EXPECT_NE(r.output.find("no motion meeting the task was found"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("--start " + (dir / "short.partial.json").string()), std::string::npos)
+  EXPECT_NE(r.output.find("--start " + (dir / "short.partial.json").string() + " --strength 2`"), std::string::npos)
       << r.output;
 }
 
