@@ -92,7 +92,7 @@ void check(const SeedArgs& args) {
                 r.landing_shift, kTimestepAgreement);
   }
   for (const RobustnessReport::Level& l : r.levels) {
-    std::printf("  sigma %.3f: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
+    std::printf("  sigma %g: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
                 l.samples, 100 * l.fraction());
   }
 }

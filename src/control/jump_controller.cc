@@ -115,8 +115,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
   c->tuck_time = r.number("tuck_time", 0, 1, c->tuck_time);
   c->open_time = r.number("open_time", 0, 1, c->open_time);
-  // Degrees in the file, like the rotation constraints; radians inside.
-  c->open_rotation = r.number("open_rotation", 0, 720, c->open_rotation * 180 / M_PI) * M_PI / 180;
+  c->open_rotation = r.number("open_rotation", 0, 4 * M_PI, c->open_rotation);  // rad, like the task's rotation
   c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);

@@ -12,9 +12,11 @@
 // apart adds K_c d^2), so input motions do not hinge
 // on integration details. f is the mean C of these rollouts; when all of them meet the
 // task, f = -robustness * min(margin, 0.1 m), where margin is the smallest slack inside
-// the allowed region (task/constraints.h, constraint_margin): a small reward for slack
-// prefers input motions that land near the middle of their box or clear their obstacle
-// with room, so the diversity optimizer starts from a motion with margin.
+// the allowed region (task/constraints.h, constraint_margin) and, for a task with the
+// half-timestep check, kTimestepAgreement minus how far apart the two landings are: a
+// small reward for slack prefers input motions that land near the middle of their box,
+// clear their obstacle with room and land alike at both timesteps, so the diversity
+// optimizer starts from a motion with margin.
 //
 // Robustness (ours): the diversity optimizer starts from M0 and samples around it, so an
 // input motion is only useful if some of its neighbourhood also meets the task. With
@@ -24,7 +26,8 @@
 // z_k for every candidate of a generation, so candidates are ranked on equal terms, and
 // fresh ones in every generation, so the search cannot tune a motion to a few fixed
 // directions), and the objective is the mean C over the 2 + P rollouts: the expected
-// penalty under small parameter changes. The result is the best candidate that meets
+// penalty under small parameter changes, each perturbation judged as the diversity
+// optimizer will judge it (with the half-timestep check where the task asks for it). The result is the best candidate that meets
 // the task at both timesteps (ranked by that mean), so a neighbourhood that meets the
 // task is preferred to a lucky point. Intermediate continuation stages go without: they
 // have to get over the raised object, which a mean over perturbations discourages (a
@@ -103,7 +106,8 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
 
 // How much of a motion's neighbourhood meets the task: C at the task's timestep and with
 // it halved, and, for each sigma, how many of `samples` perturbations (perturb() with the
-// task's seed.seed) have C = 0 at the task's timestep.
+// task's seed.seed) meet the task as the diversity optimizer judges it: C = 0 at the
+// task's timestep, and with the half-timestep check where the task asks for it.
 struct RobustnessReport {
   double constraint = 0;       // C at the task's timestep
   double constraint_fine = 0;  // C with the timestep halved

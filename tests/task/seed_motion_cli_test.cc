@@ -88,16 +88,16 @@ TEST(SeedMotionCli, EveryStageIsKeptAndASearchGoesOnFromALaterStage) {
 
 TEST(SeedMotionCli, RobustnessCheckReportsBothTimestepsAndTheNeighbourhood) {
   const auto r = cli_test::run_cli(
-      "seed-motion jump_high --robustness-check --check-sigmas 1e-6 0.5 --check-samples 3");
+      "seed-motion jump_forward --robustness-check --check-sigmas 1e-6 0.5 --check-samples 3");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("C = 0 at the task's timestep, 0 with it halved"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("landing spots at the two timesteps differ by 0.0"), std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("sigma 0.000: 3 of 3 perturbations meet the task (100 %)"),
+  EXPECT_NE(r.output.find("sigma 1e-06: 3 of 3 perturbations meet the task (100 %)"),
             std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("sigma 0.500: 0 of 3 perturbations meet the task (0 %)"),
+  EXPECT_NE(r.output.find("sigma 0.5: 0 of 3 perturbations meet the task (0 %)"),
             std::string::npos)
       << r.output;
 }

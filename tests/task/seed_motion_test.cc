@@ -69,6 +69,22 @@ TEST(Robustness, TellsAMotionsNeighbourhoodFromRandomControllers) {
   EXPECT_EQ(r.levels[1].fraction(), 0.0);
 }
 
+// A perturbation meets the task as the diversity optimizer judges it: where the task has
+// the half-timestep check, one that meets it at 2 ms but lands elsewhere (or falls) at 1 ms
+// does not count. The high jump's input motion lands 2.8 cm apart at the two timesteps
+// (3 cm allowed): steps of a thousandth of the ranges already part some of them.
+TEST(Robustness, ThePerturbationsAreJudgedWithTheHalfTimestepCheck) {
+  Task task = load_task(kTasks + "jump_high.toml");
+  ASSERT_TRUE(task.constraints.half_timestep);
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const RobustnessReport checked = measure_robustness(task, m0, {1e-3}, 16, 2);
+  task.constraints.half_timestep = false;
+  const RobustnessReport unchecked = measure_robustness(task, m0, {1e-3}, 16, 2);
+  EXPECT_GE(unchecked.levels[0].met, 14);
+  EXPECT_LE(checked.levels[0].met, unchecked.levels[0].met - 8) << checked.levels[0].met;
+}
+
 TEST(SeedMotion, AFlightRotationRequirementTheMotionMissesIsAViolation) {
   // The backflip M0 meets its task, but no candidate near it turns a full 2 pi between
   // take-off and touch-down.
