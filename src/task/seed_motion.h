@@ -27,11 +27,12 @@
 // fresh ones in every generation, so the search cannot tune a motion to a few fixed
 // directions), and the objective is the mean C over the 2 + P rollouts: the expected
 // penalty under small parameter changes, each perturbation judged as the diversity
-// optimizer will judge it (with the half-timestep check where the task asks for it). The result is the best candidate that meets
-// the task at both timesteps (ranked by that mean), so a neighbourhood that meets the
-// task is preferred to a lucky point. Intermediate continuation stages go without: they
-// have to get over the raised object, which a mean over perturbations discourages (a
-// neighbourhood that lands short of a box beats one that partly hits its face).
+// optimizer will judge it (with the half-timestep check where the task asks for it).
+// The result is the best candidate that meets the task at both timesteps (ranked by that
+// mean), so a neighbourhood that meets the task is preferred to a lucky point.
+// Intermediate continuation stages go without: they have to get over the raised object,
+// which a mean over perturbations discourages (a neighbourhood that lands short of a box
+// beats one that partly hits its face).
 // measure_robustness() reports the fraction of another set of perturbations that meet
 // the task.
 //

@@ -9,10 +9,10 @@
 // that is not the character's; a step is a foot landing after at least kMinAirTime in the
 // air, alternating feet (a foot that lands twice in a row is a stumble, not a step, and is
 // counted in `relandings`). A step's length is where the landing foot's body origin is,
-// minus where the other foot's is at that moment, in the heading frame of the root at the landing (its forward axis turned onto the ground,
-// lateral to its left). Tilt is the angle of the root's and the torso's standing "up"
-// from world vertical (the torso: the body of the deepest centre waist hinge), the largest
-// since the previous step. A fall is any contact of a non-foot geom of the character with
+// minus where the other foot's is at that moment, in the heading frame of the root at
+// the landing (its forward axis turned onto the ground, lateral to its left). Tilt is the
+// angle of the root's and the torso's standing "up" from world vertical (the torso: the
+// body of the deepest centre waist hinge), the largest since the previous step. A fall is any contact of a non-foot geom of the character with
 // something that is not the character; a walk never has both feet off the ground for
 // longer than max_flight.
 //

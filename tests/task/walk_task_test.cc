@@ -25,6 +25,17 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
+// Walk parameters kept for a test in tests/task/data/.
+ParameterSet test_walk(const TaskEvaluator& ev, const std::string& file) {
+  return ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/" + file);
+}
+
+// One evaluation of `p` on a worker of its own.
+Evaluation evaluate_once(const TaskEvaluator& ev, const ParameterSet& p) {
+  const auto worker = ev.make_worker();
+  return ev.evaluate(p.values(), *worker);
+}
+
 std::string walk_text() {
   return "name = \"w\"\n"
          "character = \"" + std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/human3d.toml\"\n"
@@ -154,8 +165,7 @@ TEST(WalkConstraints, RangesFallsAndTurns) {
 void expect_meets(const std::string& name) {
   const TaskEvaluator ev(load_task(kTasks + name + ".toml"));
   const ParameterSet p = ev.load_parameters(ev.task().m0);
-  const auto worker = ev.make_worker();
-  const Evaluation e = ev.evaluate(p.values(), *worker);
+  const Evaluation e = evaluate_once(ev, p);
   ASSERT_FALSE(e.failed) << e.failure;
   EXPECT_FALSE(e.fell) << e.summary.fall_reason;
   EXPECT_EQ(e.constraint, 0);
@@ -195,10 +205,8 @@ TEST(WalkEvaluation, PosesAreInTheStridesHeadingFrame) {
   Task task = load_task(kTasks + "robot_silly_walk.toml");
   task.walk.max_flight = 10;  // it hops at its start (WalkEvaluation.AHopIsAFall)
   const TaskEvaluator ev(task);
-  const ParameterSet p =
-      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/robot_walk_turns_round.json");
-  const auto worker = ev.make_worker();
-  const Evaluation e = ev.evaluate(p.values(), *worker);
+  const ParameterSet p = test_walk(ev, "robot_walk_turns_round.json");
+  const Evaluation e = evaluate_once(ev, p);
   ASSERT_FALSE(e.fell) << e.summary.fall_reason;
   const auto& steps = e.summary.walk.steps;
   ASSERT_EQ(steps.size(), 30u);
@@ -222,10 +230,8 @@ TEST(WalkEvaluation, PosesAreInTheStridesHeadingFrame) {
 TEST(WalkEvaluation, AHopIsAFall) {
   const TaskEvaluator ev(load_task(kTasks + "robot_silly_walk.toml"));
   ASSERT_EQ(ev.task().walk.max_flight, 0.05);
-  const ParameterSet p =
-      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/robot_walk_turns_round.json");
-  const auto worker = ev.make_worker();
-  const Evaluation e = ev.evaluate(p.values(), *worker);
+  const ParameterSet p = test_walk(ev, "robot_walk_turns_round.json");
+  const Evaluation e = evaluate_once(ev, p);
   ASSERT_TRUE(e.fell);
   EXPECT_EQ(e.summary.fall_reason, "both feet were off the ground for longer than max_flight (a hop, not a walk)");
   EXPECT_LT(e.summary.walk.steps.size(), 2u);
@@ -239,10 +245,8 @@ TEST(WalkEvaluation, AHopIsAFall) {
 // walk audit, counting steps from foot contacts, finds most of them going backward.)
 TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
   const TaskEvaluator ev(load_task(kTasks + "silly_walk.toml"));
-  const ParameterSet p =
-      ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/human_walk_slides_back.json");
-  const auto worker = ev.make_worker();
-  const Evaluation e = ev.evaluate(p.values(), *worker);
+  const ParameterSet p = test_walk(ev, "human_walk_slides_back.json");
+  const Evaluation e = evaluate_once(ev, p);
   ASSERT_FALSE(e.fell) << e.summary.fall_reason;
   const auto& steps = e.summary.walk.steps;
   ASSERT_EQ(steps.size(), 30u);
@@ -260,7 +264,7 @@ TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
   StepRecorder record;
   EvaluationOptions options;
   options.recorder = &record;
-  ev.evaluate(p.values(), *worker, options);
+  ev.evaluate(p.values(), *ev.make_worker(), options);
   const WalkAudit a = audit_walk(ev.model().get(), record, ev.body(), ev.task().walk);
   EXPECT_FALSE(a.violations.empty());
 }
@@ -271,8 +275,7 @@ TEST(WalkEvaluation, FallEndsTheRollout) {
   // Torso bent forward to its limit, no balance feedback: it falls within a few steps.
   p.set("lift.torso.waist", p.specs()[static_cast<size_t>(p.find("lift.torso.waist"))].lower);
   p.set("strike.torso.waist", p.specs()[static_cast<size_t>(p.find("strike.torso.waist"))].lower);
-  const auto worker = ev.make_worker();
-  const Evaluation e = ev.evaluate(p.values(), *worker);
+  const Evaluation e = evaluate_once(ev, p);
   ASSERT_TRUE(e.fell);
   EXPECT_LT(e.summary.walk.steps.size(), 30u);
   EXPECT_NEAR(e.stats.time, e.summary.end_time, 1e-9);
