@@ -45,6 +45,7 @@ nlohmann::json summary_json(const MotionSummary& s) {
                        {"heading", w.heading}, {"tilt", w.tilt}});
     }
     j["walk_steps"] = steps;
+    j["walk_relandings"] = s.walk.relandings;
   }
   return j;
 }

@@ -30,6 +30,22 @@ std::array<double, 3> up_in(const std::array<double, 4>& q) {
   return {R[6], R[7], R[8]};  // R^T z
 }
 
+// Which feet touch something that is not the character (the audit's rule: a foot on the
+// other foot or on the character's own body is not down).
+std::array<bool, 2> feet_on_ground(const mjModel* m, const mjData* d, const Character& body) {
+  std::array<bool, 2> down{false, false};
+  for (int c = 0; c < d->ncon; ++c) {
+    const mjContact& con = d->contact[c];
+    for (int side = 0; side < 2; ++side) {
+      const int g = side == 0 ? con.geom1 : con.geom2, other = side == 0 ? con.geom2 : con.geom1;
+      if (body.is_link(m, m->geom_bodyid[other])) continue;
+      int foot = -1;
+      if (body.is_foot_geom(m, g, &foot)) down[static_cast<size_t>(foot)] = true;
+    }
+  }
+  return down;
+}
+
 }  // namespace
 
 WalkObserver::WalkObserver(const Task& task, const Character& body, const mjModel* m,
@@ -113,8 +129,42 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
   tilt_ = std::max(tilt_, tilt(d, body_.root_body, root_up_));
   if (torso_ >= 0) tilt_ = std::max(tilt_, tilt(d, torso_, torso_up_));
 
+  // Steps: touch-downs found from the feet's contacts, as the walk audit finds them
+  // (task/walk_audit.h), not from the controller's states: a swing foot set down in the
+  // middle of its swing is a step where it was set down. Times for the air-time test
+  // are step index x timestep, as the audit computes them from the record.
+  const double ta = static_cast<double>(index_++) * m->opt.timestep;
+  const std::array<bool, 2> now = feet_on_ground(m, d, body_);
+  for (int f = 0; f < 2; ++f) {
+    const size_t i = static_cast<size_t>(f);
+    if (ground_[i] && !now[i]) lifted_[i] = ta;
+    if (!ground_[i] && now[i] && ta - lifted_[i] >= kMinAirTime) {
+      if (f == last_leg_) {
+        ++walk.relandings;
+      } else if (static_cast<int>(walk.steps.size()) < w.steps) {
+        // The step: from the other foot, where it is now, to the landing foot. (Not from
+        // where the other foot landed: a foot that slides or shuffles back after landing
+        // would let short or backward steps count as long ones.)
+        const double* p = d->xpos + 3 * body_.feet[i];
+        const double* o = d->xpos + 3 * body_.feet[1 - i];
+        const double dx = p[0] - o[0], dy = p[1] - o[1];
+        WalkStep step;
+        step.leg = f;
+        step.time = t;
+        step.forward = std::cos(raw) * dx + std::sin(raw) * dy;
+        step.lateral = -std::sin(raw) * dx + std::cos(raw) * dy;
+        step.heading = heading_;
+        step.tilt = tilt_;
+        walk.steps.push_back(step);
+        tilt_ = 0;
+      }
+      last_leg_ = f;
+    }
+    ground_[i] = now[i];
+  }
+
+  // Strides: the controller's states, for the pose samples.
   const int state = controller_.phase();
-  bool last_step = false;
   if (controller_.phase_changed() && state != state_) {
     const int ended = state_;
     if (recording_) {
@@ -127,35 +177,22 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
     state_ = state;
     if (is_lift(state)) {
       // A strike state ended: a touch-down, or a swing foot that never came down.
-      const int leg = swing_leg(ended);
-      if (!contacts_.foot[static_cast<size_t>(leg)]) return fall(d, "the swing foot did not come down");
-      // The step: from the other foot, where it is now, to the landing foot. (Not from
-      // where the other foot landed: a foot that slides or shuffles back after landing
-      // would let short or backward steps count as long ones.)
-      const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(leg)];
-      const double* o = d->xpos + 3 * body_.feet[static_cast<size_t>(1 - leg)];
-      const double dx = f[0] - o[0], dy = f[1] - o[1];
-      const double h = raw;
-      WalkStep step;
-      step.leg = leg;
-      step.time = t;
-      step.forward = std::cos(h) * dx + std::sin(h) * dy;
-      step.lateral = -std::sin(h) * dx + std::cos(h) * dy;
-      step.heading = heading_;
-      step.tilt = tilt_;
-      walk.steps.push_back(step);
-      tilt_ = 0;
+      if (!contacts_.foot[static_cast<size_t>(swing_leg(ended))]) {
+        return fall(d, "the swing foot did not come down");
+      }
+      ++strikes_;
       if (state == kLeftLift) stride_heading_ = raw;  // a stride begins
-      const int taken = static_cast<int>(walk.steps.size());
-      if (taken >= w.steps) {
-        last_step = true;
-      } else if (state == kLeftLift && taken >= w.settle_steps) {
+      if (strikes_ == w.steps) {
+        complete_ = recording_;  // the last evaluated stride has ended
+        recording_ = false;
+      } else if (state == kLeftLift && strikes_ >= w.settle_steps && strikes_ < w.steps) {
         recording_ = true;  // a stride begins after the walk has settled
       }
     }
   }
-  if (last_step) {
-    complete_ = recording_;
+  // The walk is over when it has taken its steps and the controller its strides (for a
+  // walk whose feet land only when its swings end, the same touch-down).
+  if (static_cast<int>(walk.steps.size()) >= w.steps && strikes_ >= w.steps) {
     s.end_time = t;
     return true;
   }

@@ -1,11 +1,12 @@
 // The rollout observer of a walk task (task/walk_task.h): drives the walk controller,
 // counts steps, measures each step's length in the heading frame and the pelvis and torso
 // tilt, detects falls, and ends the rollout as soon as the outcome is decided (a fall, or
-// the last step's touch-down). TaskEvaluator (task/evaluate.h) uses it for every task
+// the last step's touch-down). Steps are found from the feet's contacts, by the rule of
+// the walk audit (task/walk_audit.h), so the task and the audit count the same steps. TaskEvaluator (task/evaluate.h) uses it for every task
 // with a [walk] table.
 //
-// Pose samples (paper section 4.1): in every evaluated stride (the strides after the
-// first settle_steps steps; a stride is the four states left lift, left strike, right
+// Pose samples (paper section 4.1): in every evaluated stride (the controller's strides
+// after its first settle_steps strike states; a stride is the four states left lift, left strike, right
 // lift, right strike) each state gives `samples` poses at its state-normalized times
 // (k + 0.5) / samples, interpolated between the bracketing simulation steps:
 // 4 * samples * (steps - settle_steps) / 2 poses for a walk that takes all its steps, none
@@ -65,6 +66,12 @@ class WalkObserver : public StepHooks {
   double heading_ = 0, last_raw_heading_ = 0;  // unwrapped
   double tilt_ = 0;                     // rad, largest since the last step
   double flight_start_ = -1;            // s, when both feet last left the ground; -1 if one is down
+  // Steps from contacts.
+  long index_ = 0;                       // simulation steps observed
+  std::array<bool, 2> ground_{true, true};  // each foot on something not the character
+  std::array<double, 2> lifted_{0, 0};   // s (index x timestep), when each foot last left it
+  int last_leg_ = -1;                    // the foot that made the last step
+  int strikes_ = 0;                      // strike states ended by a touch-down
   int nq_ = 0;
   // Recording the evaluated strides.
   bool recording_ = false;

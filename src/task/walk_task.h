@@ -14,13 +14,19 @@
 //   max_flight = 0.05           # s, longest time both feet may be off the ground at once
 //   max_time = 40.0             # s; a walk that has not taken `steps` steps by then fell
 //
-// A step is a touch-down of the swing foot that ends a strike state (the controller's
-// phase changes from a strike state to the next lift state with the swing foot in
-// contact). Its length is where the new stance foot is (its body origin: the human's
-// ankle, the robot's toe joint) minus where the other foot is at that moment, in the
-// heading frame at the touch-down: forward along the root's forward axis turned onto the
-// ground, lateral to its left. (Measured from where the other foot landed instead, a foot
-// that slid or shuffled back after landing let backward steps count as long ones.)
+// A step is a foot landing after at least kMinAirTime (0.05 s) in the air, the feet
+// alternating: a foot that lands again before the other one has is re-landing (counted,
+// not a step). A foot is down while one of its geoms touches something that is not the
+// character. Steps are found from these contacts, by the rule the walk audit uses
+// (task/walk_audit.h), not from the controller's states: a swing foot set down beside
+// the other one in the middle of its swing and lifted again is a step where it was set
+// down. A step's length is where the landing foot is (its body origin: the human's ankle,
+// the robot's toe joint) minus where the other foot is at that moment, in the heading
+// frame at the touch-down: forward along the root's forward axis turned onto the ground,
+// lateral to its left. (Measured from where the other foot landed instead, a foot that
+// slid or shuffled back after landing let backward steps count as long ones.) The rollout
+// ends when the walk has taken `steps` steps and the controller has ended as many strike
+// states (for a walk whose feet land only when its swings end, the same touch-down).
 //
 // Drift and turns. Step lengths are measured in the walker's own heading frame, so a
 // walk that curves gently is judged by its steps, not by where it heads; a walk that
@@ -76,7 +82,8 @@ struct WalkStep {
 };
 
 struct WalkSummary {
-  std::vector<WalkStep> steps;
+  std::vector<WalkStep> steps;  // at most the task's `steps`
+  int relandings = 0;           // landings of the foot that had made the previous step
   double start_heading = 0;  // rad
 };
 

@@ -6,6 +6,7 @@
 // strides, in each stride's heading frame; a hop and a fall end the rollout.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -34,6 +35,29 @@ ParameterSet test_walk(const TaskEvaluator& ev, const std::string& file) {
 Evaluation evaluate_once(const TaskEvaluator& ev, const ParameterSet& p) {
   const auto worker = ev.make_worker();
   return ev.evaluate(p.values(), *worker);
+}
+
+// The walk audit (task/walk_audit.h) of one evaluation of `p`.
+WalkAudit audit_once(const TaskEvaluator& ev, const ParameterSet& p) {
+  StepRecorder record;
+  EvaluationOptions options;
+  options.recorder = &record;
+  ev.evaluate(p.values(), *ev.make_worker(), options);
+  return audit_walk(ev.model().get(), record, ev.body(), ev.task().walk);
+}
+
+// The task's steps are the audit's steps: same feet, times and lengths.
+void expect_same_steps(const Evaluation& e, const WalkAudit& a) {
+  const auto& steps = e.summary.walk.steps;
+  ASSERT_GE(a.steps.size(), steps.size());
+  for (size_t i = 0; i < steps.size(); ++i) {
+    EXPECT_EQ(steps[i].leg, a.steps[i].leg) << "step " << i + 1;
+    EXPECT_NEAR(steps[i].time, a.steps[i].time, 1e-9) << "step " << i + 1;
+    EXPECT_EQ(steps[i].forward, a.steps[i].forward) << "step " << i + 1;
+    EXPECT_EQ(steps[i].lateral, a.steps[i].lateral) << "step " << i + 1;
+    EXPECT_EQ(steps[i].tilt, a.steps[i].tilt) << "step " << i + 1;
+  }
+  EXPECT_EQ(e.summary.walk.relandings, a.relandings);
 }
 
 std::string walk_text() {
@@ -191,6 +215,10 @@ void expect_meets(const std::string& name) {
   const Evaluation again = ev.evaluate(p.values(), *other);
   EXPECT_EQ(again.stats.steps, e.stats.steps);
   EXPECT_EQ(again.poses.back().link_com, e.poses.back().link_com);
+  // The independent audit counts the same steps and finds no broken rule.
+  const WalkAudit a = audit_once(ev, p);
+  expect_same_steps(e, a);
+  EXPECT_TRUE(a.violations.empty()) << a.violations.front();
 }
 
 TEST(WalkEvaluation, HumanInputWalkMeetsTheTask) { expect_meets("silly_walk"); }
@@ -239,10 +267,10 @@ TEST(WalkEvaluation, AHopIsAFall) {
 }
 
 // A step is measured from where the other foot is at the touch-down. A human walk that a
-// run found under the earlier rule (from where the other foot had landed) moves its feet
-// after they land: measured from the landing spots its steps met the 0.5 m minimum (C = 0);
-// between the feet at each touch-down they are about 0.46 m, and it breaks the task. (The
-// walk audit, counting steps from foot contacts, finds most of them going backward.)
+// run found under an earlier rule (from where the other foot had landed) moves its feet
+// after they land: measured from the landing spots its steps met the 0.5 m minimum (C = 0).
+// Between the feet at each touch-down, found from the feet's contacts, most of its steps
+// go backward, and it breaks the task.
 TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
   const TaskEvaluator ev(load_task(kTasks + "silly_walk.toml"));
   const ParameterSet p = test_walk(ev, "human_walk_slides_back.json");
@@ -251,21 +279,44 @@ TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
   const auto& steps = e.summary.walk.steps;
   ASSERT_EQ(steps.size(), 30u);
   const double shortest = ev.task().walk.forward_center - ev.task().walk.forward_half_width;
+  int backward = 0;
   for (std::size_t i = 10; i < steps.size(); ++i) {
     EXPECT_LT(steps[i].forward, shortest) << "step " << i + 1;
-    EXPECT_GT(steps[i].forward, 0.4) << "step " << i + 1;
+    backward += steps[i].forward < 0 ? 1 : 0;
   }
+  EXPECT_GT(backward, 10);
   double step_forward = 0;
   for (const auto& term : e.report.terms)
     if (term.name == "step_forward") step_forward = term.penalty;
   EXPECT_GT(step_forward, 0);
   EXPECT_GT(e.report.total, 0);
-  // The independent audit of the same walk fails it too.
-  StepRecorder record;
-  EvaluationOptions options;
-  options.recorder = &record;
-  ev.evaluate(p.values(), *ev.make_worker(), options);
-  const WalkAudit a = audit_walk(ev.model().get(), record, ev.body(), ev.task().walk);
+  // The independent audit of the same walk counts the same steps and fails it too.
+  const WalkAudit a = audit_once(ev, p);
+  expect_same_steps(e, a);
+  EXPECT_FALSE(a.violations.empty());
+}
+
+// Steps are found from the feet's contacts, as the audit finds them. A robot walk that a
+// run found while steps were taken from the controller's strike states shuffles: now and
+// then it sets its swing foot down beside or behind the other one while its lift state
+// still runs, lifts it again and lands it 1.5 m ahead when its strike state ends. Counted
+// at the strikes, its 30 steps were all 1.47 to 1.49 m (C = 0); the audit found steps of
+// -0.26 m and 15 re-landings. The task now counts the steps the audit counts, and fails it.
+TEST(WalkEvaluation, ASwingFootSetDownMidSwingIsAStep) {
+  const TaskEvaluator ev(load_task(kTasks + "robot_silly_walk.toml"));
+  const ParameterSet p = test_walk(ev, "robot_walk_sets_foot_down_midswing.json");
+  const Evaluation e = evaluate_once(ev, p);
+  ASSERT_FALSE(e.fell) << e.summary.fall_reason;
+  const auto& steps = e.summary.walk.steps;
+  ASSERT_EQ(steps.size(), 30u);
+  for (size_t i = 1; i < steps.size(); ++i) EXPECT_NE(steps[i].leg, steps[i - 1].leg) << i;
+  double shortest = INFINITY;
+  for (size_t i = 10; i < steps.size(); ++i) shortest = std::min(shortest, steps[i].forward);
+  EXPECT_LT(shortest, 0.0);
+  EXPECT_GT(e.summary.walk.relandings, 0);
+  EXPECT_GT(e.report.total, 0);
+  const WalkAudit a = audit_once(ev, p);
+  expect_same_steps(e, a);
   EXPECT_FALSE(a.violations.empty());
 }
 
