@@ -6,6 +6,7 @@
 // optimizer starts by sampling there).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
@@ -26,9 +27,10 @@ struct SimRun {
   StepRecorder record;
 };
 
+// At the task's own timestep, or at `timestep` (s) if given.
 SimRun simulate(const std::string& name, double timestep = 0) {
   Task task = load_task(kTasks + name + ".toml");
-  task.simulation.timestep = timestep;
+  if (timestep > 0) task.simulation.timestep = timestep;
   const TaskEvaluator ev(task);
   const ParameterSet p = ev.load_parameters(task.m0);
   auto worker = ev.make_worker();
@@ -64,7 +66,7 @@ class M0 : public ::testing::TestWithParam<const char*> {};
 // Of `count` perturbations at `sigma`, at least `met` meet the task as the diversity
 // optimizer judges samples (at both timesteps where the task has the half-timestep
 // check). The backflip's and jump_over's neighbourhoods are the thinnest, which is why
-// their task files start diversity runs at a much smaller sigma0 (0.005 and 0.001); the
+// their task files start diversity runs at a much smaller sigma0 (0.005 and 0.003); the
 // bounds sit at or below what the committed M0s measure.
 struct Neighbourhood {
   double sigma;
@@ -74,7 +76,7 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"backflip", {0.005, 32, 3}},
     {"jump_forward", {0.01, 32, 12}},
     {"jump_onto", {0.01, 32, 5}},
-    {"jump_over", {0.001, 32, 1}},
+    {"jump_over", {0.002, 32, 3}},
     {"jump_high", {0.02, 32, 1}},
     {"jump_backwards", {0.01, 16, 6}},
     {"robot_jump", {0.01, 16, 2}}};
@@ -95,7 +97,8 @@ TEST_P(M0, MeetsItsTask) {
 TEST_P(M0, TimestepHalvedLandsNearby) {
   REQUIRE_M0(GetParam());
   const SimRun a = simulate(GetParam());
-  const SimRun b = simulate(GetParam(), 0.001);
+  const double timestep = TaskEvaluator(load_task(kTasks + GetParam() + ".toml")).model().get()->opt.timestep;
+  const SimRun b = simulate(GetParam(), timestep / 2);
   // Both where the feet touch down and where they come to rest (landing_shift); input
   // motions are searched for within kTimestepAgreement (3 cm), the bound here is 5 cm.
   EXPECT_LT(landing_shift(a.e.summary, b.e.summary), 0.05) << GetParam();
@@ -180,6 +183,34 @@ TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
   EXPECT_GE(r.e.summary.min_clearance, 0.02);
   EXPECT_GE(r.e.summary.feet_x, 1.0);
   EXPECT_GE(r.e.summary.touchdown_feet_x, 1.0);
+}
+
+// jump_over runs at 1 ms because at the planar human's 2 ms this long jump is
+// numerically chaotic: motions 1e-5 apart in the normalized parameters touch down
+// centimetres apart at 2 ms and within millimetres at 1 ms (measured: up to 6 cm against
+// under 3 mm), so at 2 ms no neighbourhood of M0 can meet the half-timestep check.
+TEST(M0Specifics, JumpOverChangesSmoothlyAtItsTimestep) {
+  REQUIRE_M0("jump_over");
+  const Task task = load_task(kTasks + "jump_over.toml");
+  ASSERT_EQ(task.simulation.timestep, 0.001);
+  auto spread = [&](double timestep) {
+    Task t = task;
+    t.simulation.timestep = timestep;
+    const TaskEvaluator ev(t);
+    const Eigen::VectorXd x = ev.load_parameters(t.m0).normalized();
+    auto worker = ev.make_worker();
+    EvaluationOptions options;
+    options.samples_per_phase = 0;
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Eigen::VectorXd& y : perturb(x, 1e-5, 6, 12345)) {
+      const Evaluation e = ev.evaluate_normalized(y, *worker, options);
+      lo = std::min(lo, e.summary.touchdown_feet_x);
+      hi = std::max(hi, e.summary.touchdown_feet_x);
+    }
+    return hi - lo;
+  };
+  EXPECT_LT(spread(0.001), 0.005);
+  EXPECT_GT(spread(0.002), 0.02);
 }
 
 // The 3D human jumps backwards: the feet come down within 25 cm of the spot 0.8 m behind
