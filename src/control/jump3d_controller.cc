@@ -280,6 +280,7 @@ void Jump3dController::set_parameters(const std::vector<double>& values) {
 }
 
 void Jump3dController::reset(const mjModel* m, const mjData* d) {
+  com_velocity_ = SubtreeComVelocity(m, body_.root_body);
   StanceGains gains;
   gains.com_kp = config_.com_kp;
   gains.com_kd = config_.com_kd;
@@ -474,11 +475,8 @@ void Jump3dController::landing_hips(const mjData* d, std::vector<double>& target
 void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) {
   const double t = d->time;
   const int root = body_.root_body;
-  mj_subtreeVel(m, d);
-  for (int k = 0; k < 3; ++k) {
-    com_[static_cast<size_t>(k)] = d->subtree_com[3 * root + k];
-    com_vel_[static_cast<size_t>(k)] = d->subtree_linvel[3 * root + k];
-  }
+  for (int k = 0; k < 3; ++k) com_[static_cast<size_t>(k)] = d->subtree_com[3 * root + k];
+  com_vel_ = com_velocity_(m, d);
 
   // Transitions: at most one per step.
   phase_changed_ = false;

@@ -64,6 +64,7 @@
 #include "control/controller.h"
 #include "control/jump_controller.h"
 #include "control/parameters.h"
+#include "physics/com_velocity.h"
 #include "control/stance_controller.h"
 
 namespace diverse {
@@ -186,6 +187,7 @@ class Jump3dController : public Controller {
   std::vector<double> target_;    // per joint: last commanded joint target (flight)
   std::vector<double> flight_from_;
   std::array<double, 3> com_{}, com_vel_{};
+  SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
 };
 
 }  // namespace diverse

@@ -61,6 +61,7 @@
 #include "character/character.h"
 #include "control/controller.h"
 #include "control/parameters.h"
+#include "physics/com_velocity.h"
 
 namespace diverse {
 
@@ -174,6 +175,7 @@ class JumpController : public Controller {
   std::vector<double> target_;  // per joint: last commanded target (rad)
   std::vector<double> balance_; // per joint: J^T F of this step (Nm)
   std::array<double, 3> com_{}, com_vel_{};
+  SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
   double gravity_ = 9.81;
 };
 

@@ -33,48 +33,87 @@ double cpu_seconds(clockid_t clock) {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-// Runs `work` (which returns the steps it did) until `budget` wall seconds have passed;
-// returns steps per CPU second of this thread.
-double steps_per_cpu_second(double budget, const std::function<long long()>& work) {
-  long long steps = 0;
-  const auto start = Clock::now();
-  const double cpu0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
-  do {
-    steps += work();
-  } while (seconds_since(start) < budget);
-  return static_cast<double>(steps) / std::max(1e-9, cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - cpu0);
-}
-
 double load_average() {
   double load[1] = {-1};
   return getloadavg(load, 1) == 1 ? load[0] : -1;
 }
 
-// Replays a record's inputs with plain mj_step for `budget` wall seconds; returns steps
-// per CPU second.
-double raw_step_rate(const mjModel* shared, const StepRecorder& record, double budget) {
-  mjModel* m = mj_copyModel(nullptr, shared);
-  mjData* d = mj_makeData(m);
-  const double rate = steps_per_cpu_second(budget, [&]() -> long long {
-    mj_resetData(m, d);
-    std::copy(record.qpos0.begin(), record.qpos0.end(), d->qpos);
-    std::copy(record.qvel0.begin(), record.qvel0.end(), d->qvel);
+// Replays a record's inputs with plain mj_step, on its own copy of the model.
+class RawReplay {
+ public:
+  RawReplay(const mjModel* shared, const StepRecorder& record)
+      : m_(mj_copyModel(nullptr, shared)), d_(mj_makeData(m_)), record_(record) {}
+  ~RawReplay() {
+    mj_deleteData(d_);
+    mj_deleteModel(m_);
+  }
+  RawReplay(const RawReplay&) = delete;
+  RawReplay& operator=(const RawReplay&) = delete;
+
+  // One replay of the whole record; returns its steps.
+  long long once() {
+    const StepRecorder& record = record_;
+    mj_resetData(m_, d_);
+    std::copy(record.qpos0.begin(), record.qpos0.end(), d_->qpos);
+    std::copy(record.qvel0.begin(), record.qvel0.end(), d_->qvel);
     std::size_t change = 0;
     for (int k = 0; k < record.steps(); ++k) {
       while (change < record.damping.size() && record.damping[change].step == k) {
         for (int j = 0; j < record.ndamp; ++j)
-          m->dof_damping[record.damped_dofs[static_cast<std::size_t>(j)]] = record.damping[change].values[static_cast<std::size_t>(j)];
+          m_->dof_damping[record.damped_dofs[static_cast<std::size_t>(j)]] =
+              record.damping[change].values[static_cast<std::size_t>(j)];
         ++change;
       }
       std::copy(record.ctrl.begin() + static_cast<long>(k) * record.nu,
-                record.ctrl.begin() + static_cast<long>(k + 1) * record.nu, d->ctrl);
-      mj_step(m, d);
+                record.ctrl.begin() + static_cast<long>(k + 1) * record.nu, d_->ctrl);
+      mj_step(m_, d_);
     }
     return record.steps();
-  });
-  mj_deleteData(d);
-  mj_deleteModel(m);
-  return rate;
+  }
+
+ private:
+  mjModel* m_;
+  mjData* d_;
+  const StepRecorder& record_;
+};
+
+// Raw replay and rollout measured in alternation, one run of each at a time, for about
+// 2 x `budget` wall seconds: a change in the machine's speed (other jobs, a host that
+// steals the virtual CPU, the clock) lasting longer than a rollout hits both alike, which
+// separate measurements of `budget` seconds each did not (their ratio spread by 20 points
+// on an idle machine). Each run is timed in the measuring thread's CPU time.
+struct Alternated {
+  double raw_steps_per_second = 0;
+  double rollout_steps_per_second = 0;
+  long long rollouts = 0;
+  double rollout_wall = 0;  // wall seconds spent in rollouts
+};
+
+Alternated alternate(double budget, bool raw_first, const std::function<long long()>& raw_once,
+                     const std::function<long long()>& rollout_once) {
+  long long raw_steps = 0, rollout_steps = 0;
+  double raw_cpu = 0, rollout_cpu = 0;
+  Alternated a;
+  auto timed = [](const std::function<long long()>& run, long long* steps, double* cpu) {
+    const double c0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+    *steps += run();
+    *cpu += cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - c0;
+  };
+  const auto start = Clock::now();
+  for (bool raw_turn = raw_first; seconds_since(start) < 2 * budget || a.rollouts == 0 || raw_steps == 0;
+       raw_turn = !raw_turn) {
+    if (raw_turn) {
+      timed(raw_once, &raw_steps, &raw_cpu);
+    } else {
+      const auto w0 = Clock::now();
+      timed(rollout_once, &rollout_steps, &rollout_cpu);
+      a.rollout_wall += seconds_since(w0);
+      ++a.rollouts;
+    }
+  }
+  a.raw_steps_per_second = static_cast<double>(raw_steps) / std::max(1e-9, raw_cpu);
+  a.rollout_steps_per_second = static_cast<double>(rollout_steps) / std::max(1e-9, rollout_cpu);
+  return a;
 }
 
 double median_of(std::vector<double> v) { return Spread::of(std::move(v)).median; }
@@ -192,24 +231,24 @@ ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const Parame
     return r;
   };
 
-  std::vector<double> raw, rollout, ratio, rate1, rate_n, speedup, speedup_cpu, share;
+  RawReplay raw(evaluator.model().get(), record);
+  std::vector<double> raw_rate, rollout, ratio, rate1, rate_n, speedup, speedup_cpu, share;
   for (int round = 0; round < report.rounds; ++round) {
-    double r = 0, o = 0;
     Rates one_rate, n_rate;
-    auto measure_raw = [&] { r = raw_step_rate(evaluator.model().get(), record, options.seconds); };
-    auto measure_rollout = [&] {
-      o = steps_per_cpu_second(options.seconds, [&]() -> long long {
-        return evaluator.evaluate(m0.values(), *worker).stats.steps;
-      });
+    Alternated a;
+    auto measure_steps = [&] {
+      a = alternate(options.seconds, round % 2 == 0, [&] { return raw.once(); },
+                    [&]() -> long long { return evaluator.evaluate(m0.values(), *worker).stats.steps; });
     };
     auto measure_one = [&] { one_rate = batch_rate(one); };
     auto measure_many = [&] { n_rate = batch_rate(many); };
     if (round % 2 == 0) {
-      measure_raw(); measure_rollout(); measure_one(); measure_many();
+      measure_steps(); measure_one(); measure_many();
     } else {
-      measure_many(); measure_one(); measure_rollout(); measure_raw();
+      measure_many(); measure_one(); measure_steps();
     }
-    raw.push_back(r);
+    const double r = a.raw_steps_per_second, o = a.rollout_steps_per_second;
+    raw_rate.push_back(r);
     rollout.push_back(o);
     ratio.push_back(o / r);
     rate1.push_back(one_rate.wall);
@@ -218,7 +257,7 @@ ThroughputReport measure_throughput(const TaskEvaluator& evaluator, const Parame
     speedup_cpu.push_back(n_rate.cpu_span / one_rate.cpu_span);
     share.push_back(n_rate.share);
   }
-  report.raw_steps_per_second = median_of(raw);
+  report.raw_steps_per_second = median_of(raw_rate);
   report.rollout_steps_per_second = median_of(rollout);
   report.ratio = Spread::of(ratio);
   report.rollout_ratio = report.ratio.median;
@@ -281,26 +320,14 @@ ThroughputReport measure_stance_throughput(const std::string& character_file,
   StepRecorder record;
   stand(&record);
   report.rollout_steps = record.steps();
+  RawReplay replay(model->get(), record);
   std::vector<double> raw, rollout, ratio, per_second;
   for (int round = 0; round < report.rounds; ++round) {
-    double r = 0, o = 0;
-    long long rollouts = 0;
-    Clock::time_point start;
-    double wall = 0;
-    auto measure_raw = [&] { r = raw_step_rate(model->get(), record, options.seconds); };
-    auto measure_rollout = [&] {
-      start = Clock::now();
-      o = steps_per_cpu_second(options.seconds, [&]() -> long long {
-        ++rollouts;
-        return stand(nullptr).steps;
-      });
-      wall = seconds_since(start);
-    };
-    if (round % 2 == 0) {
-      measure_raw(); measure_rollout();
-    } else {
-      measure_rollout(); measure_raw();
-    }
+    const Alternated a = alternate(options.seconds, round % 2 == 0, [&] { return replay.once(); },
+                                   [&]() -> long long { return stand(nullptr).steps; });
+    const double r = a.raw_steps_per_second, o = a.rollout_steps_per_second;
+    const long long rollouts = a.rollouts;
+    const double wall = a.rollout_wall;
     raw.push_back(r);
     rollout.push_back(o);
     ratio.push_back(o / r);

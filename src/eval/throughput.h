@@ -8,10 +8,11 @@
 //   parallel        a batch of perturbed M0 samples evaluated on a thread pool with 1
 //                   thread and with `threads` threads; speed-up = rate(threads) / rate(1)
 //
-// Robust to a shared machine: the four measurements run interleaved in `rounds` short
-// rounds (the order reversed every other round, so a drift in the machine's load hits
-// both sides alike), each round gives its own ratio and speed-up, and the report has
-// their median and spread. Raw and rollout rates count the measuring thread's CPU time
+// Robust to a shared machine: the measurements run interleaved in `rounds` short rounds
+// (the order reversed every other round, so a drift in the machine's load hits both sides
+// alike); within a round raw and rollout alternate one run at a time, so even a change
+// of speed lasting a second or two cancels in their ratio. Each round gives its own ratio
+// and speed-up, and the report has their median and spread. Raw and rollout rates count the measuring thread's CPU time
 // (CLOCK_THREAD_CPUTIME_ID), so time the thread spent descheduled by other jobs does not
 // count against either. The speed-up is wall time (what threads buy) and comes with the
 // share of the threads' cores the process actually got while it ran (process CPU time /
@@ -28,7 +29,8 @@
 namespace diverse {
 
 struct ThroughputOptions {
-  double seconds = 0.5;  // wall time of each measurement in each round
+  double seconds = 0.5;  // wall time of each measurement in each round (raw and rollout
+                         // alternating: 2 x seconds for the two together)
   int threads = 0;       // for the parallel measurement; 0 = one per core
   int batch = 64;        // samples per parallel batch
   int rounds = 7;        // >= 1
