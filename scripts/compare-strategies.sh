@@ -7,8 +7,10 @@
 # VARIANT is `ours` (default: violating samples rank below feasible ones, a variation
 # stands at its best sample) or `paper` (eq. 1 literally: --constraints penalty --point
 # mean, as the paper prints it).
-# (DIVERSE=path picks the `diverse` binary; default build/diverse.)
-# The ten runs take about 70 minutes at 500 generations on a 2-core machine. The script
+# (DIVERSE=path picks the `diverse` binary; default build/diverse. TASK=name runs another
+# task than the backflip, e.g. to try the script quickly.)
+# At 500 generations one backflip run (1 ms timestep) took 35 minutes on a 2-core machine
+# with other jobs beside it, so the ten take several hours. The script
 # can be stopped at any moment and started again with the same arguments: a finished
 # run with the same settings is kept, an interrupted one continues from its checkpoint
 # (`diverse resume`, same result as uninterrupted), anything else is run afresh.
@@ -19,6 +21,7 @@ out="${2:-$here/runs/section9}"
 variant="${3:-ours}"
 strategies="${4:-round-robin progressive}"
 diverse="${DIVERSE:-$here/build/diverse}"
+task="${TASK:-backflip}"
 case "$variant" in
   ours) constraints=dominant point=best-sample ;;
   paper) constraints=penalty point=mean ;;
@@ -27,12 +30,12 @@ esac
 [ -x "$diverse" ] || { echo "compare-strategies.sh: $diverse is not built (scripts/build.sh)" >&2; exit 2; }
 command -v jq >/dev/null || { echo "compare-strategies.sh: needs jq (scripts/setup.sh installs it)" >&2; exit 2; }
 
-# Does DIR hold a run of this comparison (strategy, seed, generations, variant)?
+# Does DIR hold a run of this comparison (task, strategy, seed, generations, variant)?
 same_run() {
   [ -f "$1/run.json" ] &&
     jq -e --arg s "$2" --argjson seed "$3" --argjson g "$generations" \
-      --arg c "$constraints" --arg p "$point" \
-      '.options.strategy == $s and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4 and .options.constraints == $c and .options.point == $p' \
+      --arg c "$constraints" --arg p "$point" --arg t "$task" \
+      '(.task_file | sub(".*/"; "") | sub("\\.toml$"; "")) == $t and .options.strategy == $s and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4 and .options.constraints == $c and .options.point == $p' \
       "$1/run.json" >/dev/null 2>&1
 }
 
@@ -48,7 +51,7 @@ for strategy in $strategies; do
       "$diverse" resume "$dir" --quiet
     else
       echo "$strategy seed $seed: running"
-      "$diverse" run backflip --n 4 --generations "$generations" --strategy "$strategy" \
+      "$diverse" run "$task" --n 4 --generations "$generations" --strategy "$strategy" \
         --seed "$seed" --constraints "$constraints" --point "$point" --out "$dir" --force --quiet
     fi
   done

@@ -259,6 +259,15 @@ TEST(Constraints, PenaltiesFollowSpec) {
   EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
   f.rotation_total = 2 * M_PI - 0.7;  // 0.2 rad beyond it
   EXPECT_NEAR(evaluate_constraints(flip, f).total, 100000 + 5000 * 0.04, 1e-6);
+  // The task file asks for 300 degrees of the turn in the air: a landed flip that turned
+  // 0.1 rad less between take-off and touch-down pays 5000 (0.1)^2.
+  f.rotation_total = 2 * M_PI;
+  f.landed = true;
+  f.rotation_flight = flip.constraints.min_flight_rotation;
+  EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
+  f.rotation_flight = flip.constraints.min_flight_rotation - 0.1;
+  EXPECT_NEAR(evaluate_constraints(flip, f).total, 5000 * 0.01, 1e-6);
+  f.landed = false;
   EXPECT_GT(constraint_margin(flip, MotionSummary{}), -2);  // defined everywhere
 }
 
