@@ -64,8 +64,8 @@
 #include "control/controller.h"
 #include "control/jump_controller.h"
 #include "control/parameters.h"
-#include "physics/com_velocity.h"
 #include "control/stance_controller.h"
+#include "physics/com_velocity.h"
 
 namespace diverse {
 

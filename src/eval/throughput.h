@@ -12,8 +12,9 @@
 // (the order reversed every other round, so a drift in the machine's load hits both sides
 // alike); within a round raw and rollout alternate one run at a time, so even a change
 // of speed lasting a second or two cancels in their ratio. Each round gives its own ratio
-// and speed-up, and the report has their median and spread. Raw and rollout rates count the measuring thread's CPU time
-// (CLOCK_THREAD_CPUTIME_ID), so time the thread spent descheduled by other jobs does not
+// and speed-up, and the report has their median and spread. Raw and rollout rates count
+// the measuring thread's CPU time (CLOCK_THREAD_CPUTIME_ID), so time the thread spent
+// descheduled by other jobs does not
 // count against either. The speed-up is wall time (what threads buy) and comes with the
 // share of the threads' cores the process actually got while it ran (process CPU time /
 // (wall time x threads)): below about 95 % other jobs held the cores, and the speed-up
