@@ -14,9 +14,8 @@
 // of speed lasting a second or two cancels in their ratio. Each round gives its own ratio
 // and speed-up, and the report has their median and spread. Raw and rollout rates count
 // the measuring thread's CPU time (CLOCK_THREAD_CPUTIME_ID), so time the thread spent
-// descheduled by other jobs does not
-// count against either. The speed-up is wall time (what threads buy) and comes with the
-// share of the threads' cores the process actually got while it ran (process CPU time /
+// descheduled by other jobs counts against neither. The speed-up is wall time (what
+// threads buy) and comes with the share of the threads' cores the process actually got while it ran (process CPU time /
 // (wall time x threads)): below about 95 % other jobs held the cores, and the speed-up
 // understates what the threads do on a free machine. A second speed-up, from CPU time,
 // estimates that: each batch counts as long as its busiest thread's CPU time.
