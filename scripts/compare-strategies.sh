@@ -8,7 +8,8 @@
 # stands at its best sample) or `paper` (eq. 1 literally: --constraints penalty --point
 # mean, as the paper prints it).
 # (DIVERSE=path picks the `diverse` binary; default build/diverse. TASK=name runs another
-# task than the backflip, e.g. to try the script quickly.)
+# task than the backflip, e.g. to try the script quickly. SEEDS="1 2" runs and reports
+# only those seeds, so a long comparison can be made a pair of runs at a time.)
 # At 500 generations one backflip run (1 ms timestep) took 35 minutes on a 2-core machine
 # with other jobs beside it, so the ten take several hours. The script
 # can be stopped at any moment and started again with the same arguments: a finished
@@ -20,6 +21,7 @@ generations="${1:-500}"
 out="${2:-$here/runs/section9}"
 variant="${3:-ours}"
 strategies="${4:-round-robin progressive}"
+seeds="${SEEDS:-1 2 3 4 5}"
 diverse="${DIVERSE:-$here/build/diverse}"
 task="${TASK:-backflip}"
 case "$variant" in
@@ -27,6 +29,10 @@ case "$variant" in
   paper) constraints=penalty point=mean ;;
   *) echo "compare-strategies.sh: VARIANT: expected ours or paper, got '$variant'" >&2; exit 2 ;;
 esac
+for seed in $seeds; do
+  [[ "$seed" =~ ^[0-9]+$ ]] || { echo "compare-strategies.sh: SEEDS: expected whole numbers separated by spaces, got '$seeds'" >&2; exit 2; }
+done
+[ -n "${seeds// /}" ] || { echo "compare-strategies.sh: SEEDS: expected at least one seed, got an empty list" >&2; exit 2; }
 [ -x "$diverse" ] || { echo "compare-strategies.sh: $diverse is not built (scripts/build.sh)" >&2; exit 2; }
 command -v jq >/dev/null || { echo "compare-strategies.sh: needs jq (scripts/setup.sh installs it)" >&2; exit 2; }
 
@@ -41,7 +47,7 @@ same_run() {
 
 runs=()
 for strategy in $strategies; do
-  for seed in 1 2 3 4 5; do
+  for seed in $seeds; do
     dir="$out/$strategy-$seed"
     runs+=("$dir")
     if same_run "$dir" "$strategy" "$seed" && [ -f "$dir/summary.json" ]; then

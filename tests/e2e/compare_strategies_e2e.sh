@@ -2,7 +2,7 @@
 # scripts/compare-strategies.sh end to end at 2 generations per run: the ten runs and
 # the table; started again, it keeps the finished runs and resumes an interrupted one
 # (its summary removed, its checkpoint kept) to the same table, whatever else the output
-# folder holds; another budget or the paper's variant of the optimizer runs afresh.
+# folder holds; SEEDS picks seeds; another budget or the paper's variant of the optimizer runs afresh.
 #
 #   compare_strategies_e2e.sh DIVERSE_BINARY SOURCE_DIR
 set -euo pipefail
@@ -31,6 +31,18 @@ grep -q '^progressive seed 3: resuming$' "$work/second.txt" || fail "progressive
 cut -d'|' -f2-7,9- "$work/table-first.md" > "$work/a"
 cut -d'|' -f2-7,9- "$work/out/table.md" > "$work/b"
 diff "$work/a" "$work/b" || fail "the table changed after resuming"
+
+# SEEDS picks seeds: their runs are kept and the table has only them.
+SEEDS="2 4" DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 2 "$work/out" > "$work/seeds.txt"
+[ "$(grep -c ': finished earlier, kept$' "$work/seeds.txt")" = 4 ] || fail "expected 4 kept runs for SEEDS: $(cat "$work/seeds.txt")"
+grep -q '^ours:  round-robin  Dmin .* (2 runs)$' "$work/seeds.txt" || fail "SEEDS did not pick two round-robin runs"
+grep -q '^round-robin seed 3' "$work/seeds.txt" && fail "SEEDS=\"2 4\" ran seed 3"
+for bad in "x" "1,2" " "; do
+  if SEEDS="$bad" DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 2 "$work/out" 2> "$work/err.txt" >/dev/null; then
+    fail "SEEDS='$bad' was accepted"
+  fi
+  grep -q "compare-strategies.sh: SEEDS: expected" "$work/err.txt" || fail "unclear SEEDS error: $(cat "$work/err.txt")"
+done
 
 # Another budget is another experiment: runs of 2 generations are not kept for 3.
 DIVERSE="$diverse" bash "$src/scripts/compare-strategies.sh" 3 "$work/out" > "$work/third.txt"
