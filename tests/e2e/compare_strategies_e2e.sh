@@ -2,7 +2,8 @@
 # scripts/compare-strategies.sh end to end at 2 generations per run: the ten runs and
 # the table; started again, it keeps the finished runs and resumes an interrupted one
 # (its summary removed, its checkpoint kept) to the same table, whatever else the output
-# folder holds; SEEDS picks seeds; another budget or the paper's variant of the optimizer runs afresh.
+# folder holds; SEEDS picks seeds; another budget or the paper's variant of the optimizer
+# runs afresh.
 #
 #   compare_strategies_e2e.sh DIVERSE_BINARY SOURCE_DIR
 set -euo pipefail
