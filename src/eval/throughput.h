@@ -15,10 +15,11 @@
 // and speed-up, and the report has their median and spread. Raw and rollout rates count
 // the measuring thread's CPU time (CLOCK_THREAD_CPUTIME_ID), so time the thread spent
 // descheduled by other jobs counts against neither. The speed-up is wall time (what
-// threads buy) and comes with the share of the threads' cores the process actually got while it ran (process CPU time /
-// (wall time x threads)): below about 95 % other jobs held the cores, and the speed-up
-// understates what the threads do on a free machine. A second speed-up, from CPU time,
-// estimates that: each batch counts as long as its busiest thread's CPU time.
+// threads buy) and comes with the share of the threads' cores the process actually got
+// while it ran (process CPU time / (wall time x threads)): below about 95 % other jobs
+// held the cores, and the speed-up understates what the threads do on a free machine. A
+// second speed-up, from CPU time, estimates that: each batch counts as long as its
+// busiest thread's CPU time.
 #pragma once
 
 #include <nlohmann/json.hpp>
