@@ -123,8 +123,85 @@ ParameterSet MotionProblem::named(const Eigen::VectorXd& x) const {
 std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
                                                       int worker) const {
   auto outcome = simulate_outcome(x, worker);
+  outcome->provisional = evaluator_->task().constraints.half_timestep && !outcome->failed &&
+                         outcome->task_constraint == 0;
   if (bounds_.any()) apply_bounds(*outcome);
   return outcome;
+}
+
+std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, const Outcome& outcome,
+                                                      int worker) const {
+  const auto& coarse = dynamic_cast<const MotionOutcome&>(outcome);
+  if (!coarse.provisional) throw std::logic_error("MotionProblem::confirm: the outcome is not provisional");
+  auto confirmed = std::make_shared<MotionOutcome>(coarse);
+  confirmed->provisional = false;
+  EvaluationOptions fine_options;
+  fine_options.samples_per_phase = 0;
+  fine_options.timestep_scale = 0.5;
+  MotionOutcome scratch;
+  const Evaluation fine = run(x, worker, fine_options, scratch);
+  MotionSummary landed;
+  landed.landed = coarse.landing.landed;
+  landed.fell = coarse.landing.fell;
+  landed.unstable = coarse.landing.unstable;
+  landed.touchdown_feet_x = coarse.landing.touchdown_x;
+  landed.touchdown_feet_y = coarse.landing.touchdown_y;
+  landed.feet_x = coarse.landing.rest_x;
+  landed.feet_y = coarse.landing.rest_y;
+  const double penalty = half_timestep_term(evaluator_->task(), landed, fine.summary, fine.constraint).penalty;
+  // In the order TaskEvaluator::evaluate adds it (0 + penalty), then the bounds' terms.
+  confirmed->task_constraint = coarse.task_constraint + penalty;
+  confirmed->constraint = confirmed->task_constraint;
+  confirmed->failed = !std::isfinite(confirmed->constraint);
+  if (bounds_.any()) apply_bounds(*confirmed);
+  confirmed->check_steps = fine.stats.steps;
+  return confirmed;
+}
+
+std::shared_ptr<const Outcome> MotionProblem::evaluate_confirmed(const Eigen::VectorXd& x,
+                                                                int worker) const {
+  auto outcome = evaluate(x, worker);
+  return outcome->provisional ? confirm(x, *outcome, worker) : outcome;
+}
+
+namespace {
+
+// Adds to an integer entry of a JSON object (made an object if it is null).
+void add(nlohmann::json& object, const char* name, long long amount) {
+  nlohmann::json& entry = object[name];
+  entry = (entry.is_number_integer() ? entry.get<long long>() : 0LL) + amount;
+}
+
+void add_steps(nlohmann::json& ledger, const char* kind, const char* outcome, long long steps) {
+  nlohmann::json& entry = ledger[kind][outcome];
+  add(entry, "rollouts", 1);
+  add(entry, "steps", steps);
+  add(ledger, "total", steps);
+}
+
+}  // namespace
+
+void MotionProblem::tally(const Outcome& outcome, nlohmann::json& ledger) const {
+  const auto& m = dynamic_cast<const MotionOutcome&>(outcome);
+  if (m.check_steps >= 0) {  // a confirmation: only its check is new
+    add_steps(ledger, "half_timestep", m.constraint > 0 ? "failed" : "held", m.check_steps);
+    return;
+  }
+  const char* result = m.fell || m.failed ? "fell" : m.task_constraint > 0 ? "failed" : "met";
+  add_steps(ledger, "rollouts", result, m.steps);
+  add(ledger, "after_decided", m.steps_after_decided);
+}
+
+long long steps_of(const nlohmann::json& ledger, const char* kind, const char* outcome) {
+  if (!ledger.is_object()) return 0;
+  if (!kind) return ledger.value("total", 0LL);
+  const auto k = ledger.find(kind);
+  if (k == ledger.end()) return 0;
+  if (k->is_number_integer()) return k->get<long long>();  // "after_decided"
+  long long sum = 0;
+  for (const auto& [name, entry] : k->items())
+    if (!outcome || name == outcome) sum += entry.value("steps", 0LL);
+  return sum;
 }
 
 void MotionProblem::apply_bounds(MotionOutcome& outcome) const {
@@ -146,11 +223,33 @@ void MotionProblem::apply_bounds(MotionOutcome& outcome) const {
 
 std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::VectorXd& x,
                                                                int worker) const {
-  const auto w = static_cast<std::size_t>(worker);
   auto outcome = std::make_shared<MotionOutcome>();
+  const Evaluation e = run(x, worker, EvaluationOptions{}, *outcome);
+  outcome->constraint = e.constraint;
+  outcome->task_constraint = e.constraint;
+  outcome->effort = e.stats.effort;
+  outcome->positive_work = e.stats.positive_work;
+  outcome->failed = e.failed || !std::isfinite(e.constraint);
+  outcome->fell = e.fell;
+  outcome->landing_x = e.summary.feet_x;
+  outcome->peak_com_z = e.summary.peak_com_z;
+  outcome->landing = {e.summary.landed, e.summary.fell, e.summary.unstable, e.summary.touchdown_feet_x,
+                      e.summary.touchdown_feet_y, e.summary.feet_x, e.summary.feet_y};
+  outcome->steps = e.stats.steps;
+  outcome->steps_after_decided = e.steps_after_decided;
+  if (!outcome->failed) {
+    outcome->features.poses.reserve(e.poses.size());
+    for (const PoseSample& sample : e.poses)
+      outcome->features.poses.push_back(make_pose(sample.link_com, link_mass_, sample.angles, sample.root));
+  }
+  return outcome;
+}
+
+Evaluation MotionProblem::run(const Eigen::VectorXd& x, int worker, const EvaluationOptions& options,
+                              MotionOutcome& out) const {
+  const auto w = static_cast<std::size_t>(worker);
+  MotionOutcome* outcome = &out;
   Evaluation e;
-  EvaluationOptions options;
-  options.half_timestep_check = true;  // when the task asks for it
   if (!vary_shape_) {
     e = evaluator_->evaluate_normalized(x, *workers_.at(w), options);
     outcome->scales = base_scales_;
@@ -185,20 +284,7 @@ std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::Vect
       e = evaluator_->evaluate(control, *slot.scene, *slot.worker, options);
     }
   }
-  outcome->constraint = e.constraint;
-  outcome->task_constraint = e.constraint;
-  outcome->effort = e.stats.effort;
-  outcome->positive_work = e.stats.positive_work;
-  outcome->failed = e.failed || !std::isfinite(e.constraint);
-  outcome->fell = e.fell;
-  outcome->landing_x = e.summary.feet_x;
-  outcome->peak_com_z = e.summary.peak_com_z;
-  if (!outcome->failed) {
-    outcome->features.poses.reserve(e.poses.size());
-    for (const PoseSample& sample : e.poses)
-      outcome->features.poses.push_back(make_pose(sample.link_com, link_mass_, sample.angles, sample.root));
-  }
-  return outcome;
+  return e;
 }
 
 Evaluation MotionProblem::simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
@@ -264,7 +350,7 @@ class Reader {
   std::size_t at_ = 0;
 };
 
-constexpr std::uint32_t kOutcomeMagic = 0x4d4f5431;  // "MOT1"
+constexpr std::uint32_t kOutcomeMagic = 0x4d4f5432;  // "MOT2"
 
 }  // namespace
 
@@ -282,6 +368,17 @@ std::string MotionProblem::encode(const Outcome& outcome) {
   w.put(m.positive_work);
   w.put(m.effort_ratio);
   w.put(m.distance_to_m0);
+  w.put(static_cast<std::uint8_t>(m.provisional));
+  w.put(static_cast<std::uint8_t>(m.landing.landed));
+  w.put(static_cast<std::uint8_t>(m.landing.fell));
+  w.put(static_cast<std::uint8_t>(m.landing.unstable));
+  w.put(m.landing.touchdown_x);
+  w.put(m.landing.touchdown_y);
+  w.put(m.landing.rest_x);
+  w.put(m.landing.rest_y);
+  w.put(m.steps);
+  w.put(m.steps_after_decided);
+  w.put(m.check_steps);
   w.put_doubles(m.scales.data(), m.scales.size());
   w.put_doubles(m.features.link_lengths.data(), m.features.link_lengths.size());
   w.put(static_cast<std::uint64_t>(m.features.poses.size()));
@@ -308,6 +405,17 @@ std::shared_ptr<const Outcome> MotionProblem::decode(const std::string& bytes) {
   m->positive_work = r.get<double>();
   m->effort_ratio = r.get<double>();
   m->distance_to_m0 = r.get<double>();
+  m->provisional = r.get<std::uint8_t>() != 0;
+  m->landing.landed = r.get<std::uint8_t>() != 0;
+  m->landing.fell = r.get<std::uint8_t>() != 0;
+  m->landing.unstable = r.get<std::uint8_t>() != 0;
+  m->landing.touchdown_x = r.get<double>();
+  m->landing.touchdown_y = r.get<double>();
+  m->landing.rest_x = r.get<double>();
+  m->landing.rest_y = r.get<double>();
+  m->steps = r.get<long long>();
+  m->steps_after_decided = r.get<long long>();
+  m->check_steps = r.get<long long>();
   m->scales = r.vector();
   m->features.link_lengths = r.vector();
   const auto poses = r.get<std::uint64_t>();

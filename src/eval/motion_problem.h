@@ -64,6 +64,18 @@ nlohmann::json to_json(const MotionBounds& bounds);
 // ..." for a field that is not a number in its range or an unknown field.
 MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string& where);
 
+// A run's simulation steps as MotionProblem::tally() keeps them (summary.json "steps"):
+//   {"total": S,
+//    "rollouts": {"met": {"rollouts": n, "steps": s}, "failed": {...}, "fell": {...}},
+//    "half_timestep": {"held": {"rollouts": n, "steps": s}, "failed": {...}},
+//    "after_decided": s}
+// "rollouts" are the evaluations at the task's timestep by outcome (met the task as far as
+// that rollout tells, missed it, fell or blew up); "half_timestep" the checks at half the
+// step by result; "after_decided" the steps of those rollouts simulated after their
+// outcome was decided (Evaluation::steps_after_decided). Missing entries count 0.
+// The total, and one figure of it: steps_of(ledger, "rollouts", "met").
+long long steps_of(const nlohmann::json& ledger, const char* kind = nullptr, const char* outcome = nullptr);
+
 // The outcome of one rollout.
 struct MotionOutcome : Outcome {
   MotionFeatures features;   // pose samples for the metrics (empty without a flight) and
@@ -79,6 +91,16 @@ struct MotionOutcome : Outcome {
   double positive_work = 0;    // J, RolloutStats::positive_work
   double effort_ratio = 0;     // effort / effort(M0), with an effort bound (else 0)
   double distance_to_m0 = 0;   // d(M, M0) in the problem's distance, with a distance bound
+  // Where the feet were at touch-down and at rest, for the half-timestep check's landing
+  // comparison (task/constraints.h, half_timestep_term) made when it is confirmed.
+  struct Landing {
+    bool landed = false, fell = false, unstable = false;
+    double touchdown_x = 0, touchdown_y = 0, rest_x = 0, rest_y = 0;  // m
+  } landing;
+  // What it cost (MotionProblem::tally): simulation steps of its rollout, of them those
+  // after its outcome was decided (Evaluation::steps_after_decided), and of the
+  // half-timestep check once confirmed (-1: no check ran).
+  long long steps = 0, steps_after_decided = 0, check_steps = -1;
 };
 
 class MotionProblem : public DiversityProblem {
@@ -94,7 +116,18 @@ class MotionProblem : public DiversityProblem {
 
   int dim() const override;
   Eigen::VectorXd reference() const override { return reference_; }
+  // One rollout. When the task asks for the half-timestep check and the motion meets the
+  // task, the outcome is provisional: confirm() runs the check.
   std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int worker) const override;
+  // The half-timestep check of a provisional outcome of x (task/evaluate.h): the same
+  // motion at half the step; the outcome's C gains the term "half_timestep", exactly as
+  // TaskEvaluator::evaluate with half_timestep_check gives it.
+  std::shared_ptr<const Outcome> confirm(const Eigen::VectorXd& x, const Outcome& outcome,
+                                         int worker) const override;
+  // evaluate() and, when that is provisional, confirm(): the final outcome at once.
+  std::shared_ptr<const Outcome> evaluate_confirmed(const Eigen::VectorXd& x, int worker) const;
+  // Simulation steps, by kind and by outcome (see steps_of()).
+  void tally(const Outcome& outcome, nlohmann::json& ledger) const override;
   double distance(const Outcome& a, const Outcome& b) const override;
 
   // Distance between two outcomes under any metric, shape included (for the summary's
@@ -140,8 +173,11 @@ class MotionProblem : public DiversityProblem {
     std::unique_ptr<SimWorker> worker;
   };
 
-  // The rollout alone, without the bounds.
+  // The rollout alone, without the bounds: at the task's timestep, or (fine) at half of
+  // it without pose samples.
   std::shared_ptr<MotionOutcome> simulate_outcome(const Eigen::VectorXd& x, int worker) const;
+  Evaluation run(const Eigen::VectorXd& x, int worker, const EvaluationOptions& options,
+                 MotionOutcome& outcome) const;
   // Adds the bounds' terms to an outcome's constraint.
   void apply_bounds(MotionOutcome& outcome) const;
 

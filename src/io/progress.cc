@@ -45,8 +45,13 @@ std::string ProgressReporter::format_line(const DiversityRecord& record,
     std::snprintf(buffer, sizeof buffer, "%s%.3g", i > 1 ? " " : "", record.dmin[i]);
     line += buffer;
   }
-  std::snprintf(buffer, sizeof buffer, "]  %.0f eval/s  left %s", evaluations_per_second,
-                format_duration(seconds_left).c_str());
+  std::snprintf(buffer, sizeof buffer, "]  %.0f eval/s", evaluations_per_second);
+  line += buffer;
+  if (record.simulation_steps > 0) {
+    std::snprintf(buffer, sizeof buffer, "  %.1fM steps", 1e-6 * static_cast<double>(record.simulation_steps));
+    line += buffer;
+  }
+  std::snprintf(buffer, sizeof buffer, "  left %s", format_duration(seconds_left).c_str());
   line += buffer;
   return line;
 }

@@ -13,7 +13,7 @@ namespace diverse {
 namespace {
 
 constexpr const char* kCheckpointFormat = "diverse.diversity_checkpoint";
-constexpr int kCheckpointVersion = 2;
+constexpr int kCheckpointVersion = 3;
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
@@ -207,7 +207,8 @@ nlohmann::json to_json(const DiversityRecord& r) {
           {"variation", r.variation},   {"D", r.D},
           {"best_D", r.best_D},         {"constraint", vector_json(r.constraint)},
           {"dmin", vector_json(r.dmin)}, {"evaluations", r.evaluations},
-          {"samples", r.samples},       {"feasible", r.feasible}};
+          {"samples", r.samples},       {"feasible", r.feasible},
+          {"confirmations", r.confirmations}, {"simulation_steps", r.simulation_steps}};
 }
 
 namespace {
@@ -225,6 +226,8 @@ DiversityRecord record_from_json(const nlohmann::json& j) {
   // Absent from checkpoints written before they were counted.
   if (j.contains("samples")) r.samples = integer_from_json<int>(j.at("samples"), "log.samples");
   if (j.contains("feasible")) r.feasible = integer_from_json<int>(j.at("feasible"), "log.feasible");
+  r.confirmations = integer_from_json<long long>(j.at("confirmations"), "log.confirmations");
+  r.simulation_steps = integer_from_json<long long>(j.at("simulation_steps"), "log.simulation_steps");
   return r;
 }
 
@@ -235,13 +238,59 @@ DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem, ThreadPo
     : problem_(&problem), pool_(&pool), batch_(batch) {}
 
 std::vector<std::shared_ptr<const Outcome>> DiversityOptimizer::evaluate_all(
-    const std::vector<Eigen::VectorXd>& xs) const {
-  if (!batch_) return evaluate_on_pool(*problem_, *pool_, xs);
-  std::vector<std::shared_ptr<const Outcome>> outcomes = batch_->evaluate(xs);
-  if (outcomes.size() != xs.size())
-    throw std::logic_error("diversity: BatchEvaluator returned the wrong number of outcomes");
-  for (auto& outcome : outcomes) outcome = checked(std::move(outcome));
+    const std::vector<Eigen::VectorXd>& xs, bool tally) {
+  std::vector<std::shared_ptr<const Outcome>> outcomes;
+  if (!batch_) {
+    outcomes = evaluate_on_pool(*problem_, *pool_, xs);
+  } else {
+    outcomes = batch_->evaluate(xs);
+    if (outcomes.size() != xs.size())
+      throw std::logic_error("diversity: BatchEvaluator returned the wrong number of outcomes");
+    for (auto& outcome : outcomes) outcome = checked(std::move(outcome));
+  }
+  if (tally)
+    for (const auto& outcome : outcomes) problem_->tally(*outcome, ledger_);
   return outcomes;
+}
+
+void DiversityOptimizer::confirm_all(const std::vector<Eigen::VectorXd>& xs,
+                                     std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                                     bool tally) {
+  std::vector<std::size_t> open;
+  for (std::size_t k = 0; k < outcomes.size(); ++k)
+    if (outcomes[k]->provisional) open.push_back(k);
+  if (open.empty()) return;
+  // Confirmations run on this process's pool: they are few, and each gives the same
+  // outcome bit for bit wherever it runs.
+  std::vector<std::shared_ptr<const Outcome>> confirmed(open.size());
+  pool_->parallel_for(open.size(), [&](std::size_t i, int worker) {
+    confirmed[i] = checked(problem_->confirm(xs[open[i]], *outcomes[open[i]], worker));
+    if (confirmed[i]->provisional)
+      throw std::logic_error("diversity: DiversityProblem::confirm returned a provisional outcome");
+  });
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    outcomes[open[i]] = confirmed[i];
+    if (tally) problem_->tally(*confirmed[i], ledger_);
+  }
+  confirmations_ += tally ? static_cast<long long>(open.size()) : 0;
+}
+
+std::size_t DiversityOptimizer::choose_confirmed(int v, const std::vector<Eigen::VectorXd>& xs,
+                                                 std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                                                 std::size_t first, std::vector<double>& C,
+                                                 std::vector<double>& D) {
+  const std::size_t n = C.size() - 1;  // candidates; the last entry is the incumbent
+  for (;;) {
+    const std::size_t best = best_candidate(C, D);
+    if (best == n || !outcomes[first + best]->provisional) return best;
+    // The winner is provisional: confirm it, rank it again with its final C, and choose
+    // again. A confirmation that holds ends the search; one that fails drops the sample.
+    std::vector<std::shared_ptr<const Outcome>> one{outcomes[first + best]};
+    confirm_all({xs[best]}, one, true);
+    outcomes[first + best] = one.front();
+    C[best] = scored_constraint(*one.front());
+    D[best] = replaced_objective(*problem_, outcomes_, current_, v, *one.front(), options_.k);
+  }
 }
 
 DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
@@ -258,7 +307,9 @@ DiversityOptimizer::DiversityOptimizer(const DiversityProblem& problem,
   }
 
   // Every variation starts at P_0, so all share M_0's outcome until they move.
-  const auto m0 = evaluate_all({p0}).front();
+  std::vector<std::shared_ptr<const Outcome>> first = evaluate_all({p0});
+  confirm_all({p0}, first, true);
+  const auto m0 = first.front();
   evaluations_ = 1;
   points_.assign(n + 1, p0);
   outcomes_.assign(n + 1, m0);
@@ -406,10 +457,13 @@ void DiversityOptimizer::step_variation(int v) {
   // single evaluation does not leave the other workers idle.
   std::vector<Eigen::VectorXd> batch = xs;
   if (pending_ > 0) batch.push_back(points_[pending_]);  // only with VariationPoint::kMean
-  const auto outcomes = evaluate_all(batch);
-  if (pending_ > 0) settle_pending(outcomes.back());
+  auto outcomes = evaluate_all(batch);
+  if (pending_ > 0) {
+    std::vector<std::shared_ptr<const Outcome>> mean{outcomes.back()};
+    confirm_all({batch.back()}, mean, true);
+    settle_pending(mean.front());
+  }
   evaluations_ += static_cast<long long>(xs.size());
-  count_samples(outcomes, xs.size());
 
   // Each sample replaces M_v in the current set and is ranked by its D and its own C.
   std::vector<double> D(xs.size()), C(xs.size());
@@ -417,13 +471,17 @@ void DiversityOptimizer::step_variation(int v) {
     D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
     C[k] = scored_constraint(*outcomes[k]);
   });
-  es.tell(fitness(C, D));
 
   if (options_.point == VariationPoint::kBestSample) {
-    // M_v becomes this generation's best sample if it beats M_v as it stands.
+    // M_v becomes this generation's best sample if it beats M_v as it stands, confirmed
+    // (DiversityProblem::confirm) before it may; CMA-ES learns every confirmation's result.
     D.push_back(current_.D);
     C.push_back(current_.constraint[v]);
-    const std::size_t best = best_candidate(C, D);
+    const std::size_t best = choose_confirmed(v, xs, outcomes, 0, C, D);
+    D.pop_back();
+    C.pop_back();
+    count_samples(outcomes, xs.size());
+    es.tell(fitness(C, D));
     if (best < xs.size()) {
       points_[v] = xs[best];
       outcomes_[v] = outcomes[best];
@@ -431,6 +489,8 @@ void DiversityOptimizer::step_variation(int v) {
     finish_step(v);
     return;
   }
+  count_samples(outcomes, xs.size());
+  es.tell(fitness(C, D));
   // The new mean is what the other variations' samples are scored against from now on;
   // it is evaluated with the next batch (or at the end of the generation).
   points_[v] = es.mean();
@@ -460,9 +520,8 @@ void DiversityOptimizer::step_simultaneous() {
     batch.insert(batch.end(), xs[v].begin(), xs[v].end());
   }
   if (active.empty()) return;
-  const auto outcomes = evaluate_all(batch);
+  auto outcomes = evaluate_all(batch);
   evaluations_ += static_cast<long long>(batch.size());
-  count_samples(outcomes, batch.size());
 
   // Each sample of variation v replaces M_v in the set as it stood when the generation
   // was drawn, ranked by its D and its own C; every instance learns from that.
@@ -470,16 +529,22 @@ void DiversityOptimizer::step_simultaneous() {
   std::vector<int> owner(batch.size());
   for (int v : active)
     for (std::size_t k = 0; k < xs[v].size(); ++k) owner[first[v] + k] = v;
+  const std::vector<std::shared_ptr<const Outcome>> drawn = outcomes_;
+  const DiversityScore drawn_score = current_;
   pool_->parallel_for(batch.size(), [&](std::size_t k, int) {
-    D[k] = replaced_objective(*problem_, outcomes_, current_, owner[k], *outcomes[k], options_.k);
+    D[k] = replaced_objective(*problem_, drawn, drawn_score, owner[k], *outcomes[k], options_.k);
     C[k] = scored_constraint(*outcomes[k]);
   });
-  for (int v : active) {
-    const auto begin = static_cast<std::ptrdiff_t>(first[v]);
-    const auto end = begin + static_cast<std::ptrdiff_t>(xs[v].size());
-    cmas_[v - 1].tell(fitness(std::vector<double>(C.begin() + begin, C.begin() + end),
-                              std::vector<double>(D.begin() + begin, D.begin() + end)));
-  }
+  auto tell_all = [&] {
+    count_samples(outcomes, batch.size());
+    for (int v : active) {
+      const auto begin = static_cast<std::ptrdiff_t>(first[v]);
+      const auto end = begin + static_cast<std::ptrdiff_t>(xs[v].size());
+      cmas_[v - 1].tell(fitness(std::vector<double>(C.begin() + begin, C.begin() + end),
+                                std::vector<double>(D.begin() + begin, D.begin() + end)));
+    }
+  };
+  if (options_.point != VariationPoint::kBestSample) tell_all();
 
   if (options_.point == VariationPoint::kBestSample) {
     // The variations move one after another, in order 1..N, each to its best sample if
@@ -496,20 +561,30 @@ void DiversityOptimizer::step_simultaneous() {
       });
       Dv.push_back(current_.D);
       Cv.push_back(current_.constraint[v]);
-      const std::size_t best = best_candidate(Cv, Dv);
+      const std::size_t best = choose_confirmed(v, xs[v], outcomes, first[v], Cv, Dv);
+      // A confirmation changes the sample's C and so its D in the drawn set as well.
+      for (std::size_t k = 0; k < lambda; ++k) {
+        const Outcome& o = *outcomes[first[v] + k];
+        if (scored_constraint(o) != C[first[v] + k]) {
+          C[first[v] + k] = scored_constraint(o);
+          D[first[v] + k] = replaced_objective(*problem_, drawn, drawn_score, v, o, options_.k);
+        }
+      }
       if (best < lambda) {
         points_[v] = xs[v][best];
         outcomes_[v] = outcomes[first[v] + best];
         rescore();
       }
     }
+    tell_all();
     finish_step(0);
     return;
   }
   // The paper's choice: every variation stands at its new mean, evaluated in one batch.
   std::vector<Eigen::VectorXd> means;
   for (int v : active) means.push_back(cmas_[v - 1].mean());
-  const auto mean_outcomes = evaluate_all(means);
+  auto mean_outcomes = evaluate_all(means);
+  confirm_all(means, mean_outcomes, true);
   evaluations_ += static_cast<long long>(means.size());
   for (std::size_t i = 0; i < active.size(); ++i) {
     points_[active[i]] = means[i];
@@ -538,7 +613,9 @@ void DiversityOptimizer::step_joint() {
   motions.reserve(lambda * n);
   for (std::size_t k = 0; k < lambda; ++k)
     for (int v = 0; v < n; ++v) motions.push_back(xs[k].segment(v * dim, dim));
-  const std::vector<std::shared_ptr<const Outcome>> outcomes = evaluate_all(motions);
+  // A sample set's motions are scored together, so every provisional one is confirmed.
+  std::vector<std::shared_ptr<const Outcome>> outcomes = evaluate_all(motions);
+  confirm_all(motions, outcomes, true);
   evaluations_ += static_cast<long long>(lambda * n);
   count_samples(outcomes, outcomes.size());
   std::vector<double> D(lambda), C(lambda);
@@ -567,7 +644,8 @@ void DiversityOptimizer::step_joint() {
   const Eigen::VectorXd mean = es.mean();
   std::vector<Eigen::VectorXd> means;
   for (int v = 1; v <= n; ++v) means.push_back(mean.segment((v - 1) * dim, dim));
-  const auto mean_outcomes = evaluate_all(means);
+  auto mean_outcomes = evaluate_all(means);
+  confirm_all(means, mean_outcomes, true);
   evaluations_ += n;
   for (int v = 1; v <= n; ++v) {
     points_[v] = means[v - 1];
@@ -592,6 +670,8 @@ void DiversityOptimizer::finish_step(int variation) {
   record.evaluations = evaluations_;
   record.samples = step_samples_;
   record.feasible = step_feasible_;
+  record.confirmations = confirmations_;
+  record.simulation_steps = ledger_.is_object() ? ledger_.value("total", 0LL) : 0LL;
   log_.push_back(record);
 
   // A path records where a variation went: a point for every step that moved it.
@@ -609,7 +689,11 @@ void DiversityOptimizer::finish_step(int variation) {
 }
 
 void DiversityOptimizer::end_generation() {
-  if (pending_ > 0) settle_pending(evaluate_all({points_[pending_]}).front());
+  if (pending_ > 0) {
+    std::vector<std::shared_ptr<const Outcome>> mean = evaluate_all({points_[pending_]});
+    confirm_all({points_[pending_]}, mean, true);
+    settle_pending(mean.front());
+  }
   best_history_.push_back(merit(best_.score));
   const int window = options_.window;
   // Stagnation: over the window, the best set neither lost violation nor gained epsilon D.
@@ -687,6 +771,8 @@ nlohmann::json DiversityOptimizer::checkpoint() const {
   j["generation"] = generation_;
   j["steps"] = steps_;
   j["evaluations"] = evaluations_;
+  j["confirmations"] = confirmations_;
+  j["ledger"] = ledger_;
   j["stop"] = to_string(stop_);
   j["active"] = active_;
   j["phase_start"] = phase_start_;
@@ -740,6 +826,8 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
     opt.generation_ = integer_from_json<long long>(j.at("generation"), "checkpoint: generation");
     opt.steps_ = integer_from_json<long long>(j.at("steps"), "checkpoint: steps");
     opt.evaluations_ = integer_from_json<long long>(j.at("evaluations"), "checkpoint: evaluations");
+    opt.confirmations_ = integer_from_json<long long>(j.at("confirmations"), "checkpoint: confirmations");
+    opt.ledger_ = j.at("ledger");
     opt.stop_ = parse_stop(j.at("stop").get<std::string>());
     opt.active_ = integer_from_json<int>(j.at("active"), "checkpoint: active");
     opt.phase_start_ = integer_from_json<long long>(j.at("phase_start"), "checkpoint: phase_start");
@@ -795,8 +883,8 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
       (opt.active_ < 1 || opt.active_ > opt.options_.variations))
     throw UserError("checkpoint: active: expected a variation in [1, " +
                     std::to_string(opt.options_.variations) + "]");
-  if (opt.generation_ < 0 || opt.steps_ < 0 || opt.evaluations_ < 0)
-    throw UserError("checkpoint: generation, steps, evaluations: expected counts >= 0");
+  if (opt.generation_ < 0 || opt.steps_ < 0 || opt.evaluations_ < 0 || opt.confirmations_ < 0)
+    throw UserError("checkpoint: generation, steps, evaluations, confirmations: expected counts >= 0");
 
   // Outcomes are not stored: evaluate the distinct points of the current and best sets
   // again (evaluate() is a pure function of x, so these are the same outcomes).
@@ -811,7 +899,8 @@ DiversityOptimizer DiversityOptimizer::from_checkpoint(const DiversityProblem& p
   std::vector<std::size_t> current_index, best_index;
   for (const auto& p : opt.points_) current_index.push_back(index_of(p));
   for (const auto& p : opt.best_.points) best_index.push_back(index_of(p));
-  const auto outcomes = opt.evaluate_all(distinct);
+  auto outcomes = opt.evaluate_all(distinct, false);
+  opt.confirm_all(distinct, outcomes, false);
   for (std::size_t i : current_index) opt.outcomes_.push_back(outcomes[i]);
   for (std::size_t i : best_index) opt.best_.outcomes.push_back(outcomes[i]);
 

@@ -81,6 +81,18 @@
 // The result is the best set seen: after every step the current set (P_0 and where every
 // variation stands) is scored, and the best one under the rule above is kept.
 //
+// Confirmation. A problem may return provisional outcomes (optimize/objective.h): samples
+// that meet the constraints as far as their own evaluation tells, whose final C needs a
+// dearer check (a motion's half-timestep rollout). The check decides something only where
+// a variation would stand at the sample, so it is spent there: the best candidate of a
+// step is confirmed before the variation moves to it, and if the check fails the sample
+// takes its final C and the next best candidate is considered, until the winner is a
+// confirmed sample or the incumbent. CMA-ES is told every sample's C as it then stands
+// (the unconfirmed ones count as meeting the constraints). Means (mean), the sets of the
+// joint strategy, M_0 and a restored checkpoint's sets are confirmed at once. So every set
+// scored, kept or returned holds confirmed outcomes only, as if every sample had been
+// checked, at the cost of a few checks per generation instead of one per feasible sample.
+//
 // Determinism. CMA instance v (1..N; 0 for joint) draws from derive_seed(seed, {v}); a
 // generation's samples are drawn before any is evaluated, evaluated in parallel on the
 // thread pool, and written by index, so results are bit-identical for any thread count.
@@ -158,6 +170,8 @@ struct DiversityRecord {
   long long evaluations = 0;   // evaluations so far, including this step's
   int samples = 0;             // the step's samples (joint: motions of its sample sets)
   int feasible = 0;            // of those, how many met their constraints (C = 0)
+  long long confirmations = 0;     // provisional outcomes confirmed so far
+  long long simulation_steps = 0;  // the ledger's "total" so far (DiversityProblem::tally)
 };
 nlohmann::json to_json(const DiversityRecord& record);
 
@@ -211,6 +225,10 @@ class DiversityOptimizer {
   DiversityStop stop_reason() const { return stop_; }
   long long generation() const { return generation_; }
   long long evaluations() const { return evaluations_; }
+  // Provisional outcomes confirmed so far (DiversityProblem::confirm), beside evaluations.
+  long long confirmations() const { return confirmations_; }
+  // What the evaluations cost so far, as the problem tallies it (DiversityProblem::tally).
+  const nlohmann::json& ledger() const { return ledger_; }
   const DiversityOptions& options() const { return options_; }
 
   const std::vector<DiversityRecord>& log() const { return log_; }
@@ -252,8 +270,21 @@ class DiversityOptimizer {
   };
 
   DiversityOptimizer(const DiversityProblem& problem, ThreadPool& pool, BatchEvaluator* batch);
-  // Outcomes of xs in index order: through batch_ if set, else on the pool.
-  std::vector<std::shared_ptr<const Outcome>> evaluate_all(const std::vector<Eigen::VectorXd>& xs) const;
+  // Outcomes of xs in index order: through batch_ if set, else on the pool; each tallied
+  // in the ledger when `tally` (DiversityProblem::tally).
+  std::vector<std::shared_ptr<const Outcome>> evaluate_all(const std::vector<Eigen::VectorXd>& xs,
+                                                           bool tally = true);
+  // Replaces every provisional outcome of xs by its confirmation (DiversityProblem::confirm),
+  // on the pool; counted and tallied when `tally`.
+  void confirm_all(const std::vector<Eigen::VectorXd>& xs,
+                   std::vector<std::shared_ptr<const Outcome>>& outcomes, bool tally);
+  // best_candidate() over variation v's candidates outcomes[first..] (scored in C and D,
+  // the incumbent last), confirming the winner while it is provisional and choosing again
+  // with its final C and D (updated in C, D and outcomes) until the winner is confirmed
+  // or is the incumbent.
+  std::size_t choose_confirmed(int v, const std::vector<Eigen::VectorXd>& xs,
+                               std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                               std::size_t first, std::vector<double>& C, std::vector<double>& D);
   CmaesOptions cma_options(int dim, int instance) const;
   int present() const;  // motions in the current set, M_0 included
   void step_variation(int variation);
@@ -281,6 +312,8 @@ class DiversityOptimizer {
   long long generation_ = 0;
   long long steps_ = 0;
   long long evaluations_ = 0;
+  long long confirmations_ = 0;
+  nlohmann::json ledger_;
   DiversityStop stop_ = DiversityStop::kNone;
   // Progressive: the variation being optimized, when its phase began, and its budget.
   int active_ = 0;

@@ -1,11 +1,20 @@
 #include "optimize/objective.h"
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace diverse {
+
+std::shared_ptr<const Outcome> DiversityProblem::confirm(const Eigen::VectorXd&, const Outcome&,
+                                                         int) const {
+  throw std::logic_error("DiversityProblem::confirm: this problem gave a provisional outcome "
+                         "but does not confirm outcomes");
+}
+
+void DiversityProblem::tally(const Outcome&, nlohmann::json&) const {}
 
 bool is_failure(const Outcome& outcome) {
   return outcome.failed || !std::isfinite(outcome.constraint);

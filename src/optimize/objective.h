@@ -23,6 +23,7 @@
 
 #include <Eigen/Dense>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <vector>
 
 namespace diverse {
@@ -34,6 +35,9 @@ struct Outcome {
   virtual ~Outcome() = default;
   double constraint = 0.0;  // C(M) >= 0, 0 exactly when the task is met
   bool failed = false;      // no meaningful result (e.g. the simulation blew up)
+  // Meets the constraints as far as evaluate() tells, but its final C needs a dearer
+  // check (DiversityProblem::confirm); until confirmed it ranks as meeting them.
+  bool provisional = false;
 };
 
 // Constraint value used for a failed outcome whose own value is not finite.
@@ -55,6 +59,26 @@ class DiversityProblem {
   virtual std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int worker) const = 0;
   // d(a, b) >= 0, symmetric. Never called with a failed outcome. Thread-safe.
   virtual double distance(const Outcome& a, const Outcome& b) const = 0;
+
+  // Checks that are dear and decide little are done only where they decide something.
+  // evaluate() may return a provisional outcome (Outcome::provisional): one that meets
+  // the constraints as far as its own evaluation tells, whose final C needs a further
+  // check (for a motion: the same motion simulated at half the timestep). confirm(x,
+  // outcome, worker) runs that check on the provisional outcome evaluate(x) returned and
+  // gives the final outcome (not provisional), equal to what evaluate() would give if it
+  // ran the check at once. The optimizer confirms an outcome before a variation may stand
+  // at it, so every set it scores, keeps or returns holds only confirmed outcomes.
+  // Thread-safe like evaluate(). The default is for problems that are never provisional.
+  virtual std::shared_ptr<const Outcome> confirm(const Eigen::VectorXd& x, const Outcome& outcome,
+                                                 int worker) const;
+
+  // What evaluations cost, for the run's accounting (e.g. simulation steps by kind and
+  // by outcome): adds one outcome's cost to `ledger`, a JSON object the problem defines
+  // (null at the start). The optimizer calls it on its own thread, in a fixed order, for
+  // every outcome it asked for (samples, means, confirmations; not the re-evaluations of
+  // a restored checkpoint) and keeps the ledger in its checkpoints; an integer "total"
+  // entry, when the problem keeps one, is logged with every step. Default: nothing.
+  virtual void tally(const Outcome& outcome, nlohmann::json& ledger) const;
 };
 
 // D and its parts for one set of motions M_0..M_N.

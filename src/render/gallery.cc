@@ -125,8 +125,8 @@ nlohmann::json path_data(const RunView& run, const GalleryOptions& options, nloh
   }
   std::vector<std::shared_ptr<const Outcome>> outcomes(jobs.size() + 1);
   pool.parallel_for(jobs.size() + 1, [&](std::size_t j, int worker) {
-    outcomes[j] = j == 0 ? problem.evaluate(problem.reference(), worker)
-                         : problem.evaluate(paths[jobs[j - 1].variation][static_cast<std::size_t>(jobs[j - 1].point)].x, worker);
+    outcomes[j] = j == 0 ? problem.evaluate_confirmed(problem.reference(), worker)
+                         : problem.evaluate_confirmed(paths[jobs[j - 1].variation][static_cast<std::size_t>(jobs[j - 1].point)].x, worker);
   });
   const Outcome& reference = *outcomes[0];
 

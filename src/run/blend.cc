@@ -129,17 +129,17 @@ nlohmann::json write_blend(const fs::path& run_dir, const BlendOptions& options)
   const std::size_t jobs = count + static_cast<std::size_t>(K) + path_jobs.size();
   pool.parallel_for(jobs, [&](std::size_t j, int worker) {
     if (j < count) {
-      motion_out[j] = problem.evaluate(rp.motions[j], worker);
+      motion_out[j] = problem.evaluate_confirmed(rp.motions[j], worker);
     } else if (j < count + static_cast<std::size_t>(K)) {
       const std::size_t k = j - count;
-      blend_out[k] = problem.evaluate(points[k], worker);
+      blend_out[k] = problem.evaluate_confirmed(points[k], worker);
       // The blend as a motion file: simulated again with recording on, on its own body.
       const std::string stem = numbered('b', k + 1);
       write_motion(*rp.evaluator, problem.named(points[k]), {numbered('B', k + 1), dir / "model" / (stem + ".xml")},
                    dir / "motions" / (stem + ".json"));
     } else {
       const PathJob& p = path_jobs[j - count - static_cast<std::size_t>(K)];
-      path_out[j - count - static_cast<std::size_t>(K)] = problem.evaluate(p.x, worker);
+      path_out[j - count - static_cast<std::size_t>(K)] = problem.evaluate_confirmed(p.x, worker);
     }
   });
 

@@ -183,6 +183,8 @@ void write_run_outputs(const RunOutputs& o) {
       {"max_generations", options.max_generations},
       {"generations", result.generations},
       {"evaluations", result.evaluations},
+      {"confirmations", o.optimizer.confirmations()},
+      {"steps", o.optimizer.ledger()},
       {"stop", to_string(result.stop)},
       {"D", result.score.D},
       {"all_satisfied", (result.score.constraint.array() == 0.0).all()},

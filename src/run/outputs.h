@@ -30,7 +30,9 @@ struct RunOutputs {
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"
 // the parameter groups, "strength", "bounds"; "samples" the optimizer's samples and
-// "feasible_samples" how many of them met their constraints), per motion its C (the
+// "feasible_samples" how many of them met their constraints; "confirmations" the
+// half-timestep checks the optimizer ran, "steps" the simulation steps by kind and outcome,
+// eval/motion_problem.h, steps_of()), per motion its C (the
 // task's constraints and the bounds'; "task_constraint" the task's alone), dmin, effort
 // (N^2 m^2 s), "effort_ratio" to M0's, "positive_work" (J), "distance_to_m0" in the
 // objective's distance, "within_bounds", shape scales and link lengths (m,

@@ -276,7 +276,9 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   if (progress)
     progress->finish("optimization ended (" + std::string(to_string(optimizer.stop_reason())) +
                      ") after " + std::to_string(optimizer.generation()) + " generations, " +
-                     std::to_string(optimizer.evaluations()) + " evaluations");
+                     std::to_string(optimizer.evaluations()) + " evaluations, " +
+                     std::to_string(optimizer.confirmations()) + " half-timestep checks, " +
+                     std::to_string(steps_of(optimizer.ledger())) + " simulation steps");
 
   RunOutputs outputs{dir, *setup.evaluator, problem, optimizer, pool};
   outputs.wall_seconds = elapsed();

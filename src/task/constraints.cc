@@ -106,6 +106,24 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
   return report;
 }
 
+double peak_bound(const Task& task, const MotionSummary& motion) {
+  const TaskConstraints& c = task.constraints;
+  if (!c.peak_height) return 0;
+  const double d = std::max(0.0, peak_height_required(c, motion) - motion.peak_com_z);
+  return c.weight * d * d;
+}
+
+double touchdown_bound(const Task& task, const MotionSummary& motion) {
+  MotionSummary at_touchdown = motion;
+  at_touchdown.fell = false;
+  at_touchdown.feet_x = motion.touchdown_feet_x;
+  at_touchdown.feet_y = motion.touchdown_feet_y;
+  at_touchdown.feet_z = motion.touchdown_feet_z;
+  // The rotation from standing to standing is known only at rest.
+  at_touchdown.rotation_total = 2 * M_PI * task.constraints.rotation_turns;
+  return evaluate_constraints(task, at_touchdown).total;
+}
+
 double constraint_margin(const Task& task, const MotionSummary& motion) {
   if (task.walk.enabled) return walk_margin(task, motion);
   const TaskConstraints& c = task.constraints;

@@ -82,6 +82,15 @@ double landing_shift(const MotionSummary& a, const MotionSummary& b);
 ConstraintTerm half_timestep_term(const Task& task, const MotionSummary& coarse,
                                   const MotionSummary& fine, double fine_c);
 
+// Lower bounds on a jump's C from what is known part-way through its rollout, for telling
+// when its outcome is decided (TaskEvaluator: Evaluation::steps_after_decided), never for C
+// itself. peak_bound(): once the peak is behind, the peak-height term; touchdown_bound():
+// at the first touch-down, every term the rest of the motion can only make worse (the
+// landing spot and rotation in the air, the obstacle clearance, the forward pitch, the
+// peak), with the feet at rest taken to be where they touched down.
+double peak_bound(const Task& task, const MotionSummary& motion);
+double touchdown_bound(const Task& task, const MotionSummary& motion);
+
 // How far inside the allowed region the motion is: the smallest slack (m) over the
 // task's geometric constraints (landing box, box edges, clearance, length, peak height;
 // rotation slack counts 0.2 m per rad), negative when violated. Used only to prefer

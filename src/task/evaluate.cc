@@ -31,9 +31,14 @@ class JumpHooks : public StepHooks {
     controller_.control(m, d, contacts_, drive_);
   }
 
+  // Observed steps from which the motion could no longer meet the task (-1: none yet).
+  long decided_at() const { return decided_; }
+  long observed() const { return index_; }
+
   bool observe(const mjModel* m, const mjData* d) override {
     MotionSummary& s = out_.summary;
     const double t = d->time;
+    ++index_;
     const double pitch = root_pitch(m, d);
     last_pitch_ = pitch;
     const int phase = controller_.phase();
@@ -71,6 +76,7 @@ class JumpHooks : public StepHooks {
       out_.flight_qpos.insert(out_.flight_qpos.end(), d->qpos, d->qpos + m->nq);
     }
     if (airborne) s.peak_com_z = std::max(s.peak_com_z, com_z);
+    if (phase == fall_ && changed) decide_if(peak_bound(task_, s) > 0);  // the peak is behind
     if (phase == land_ && changed) {
       if (!s.took_off || controller_.gave_up()) return fall(t, "never left the ground", d);
       s.landed = true;
@@ -78,6 +84,7 @@ class JumpHooks : public StepHooks {
       s.touchdown_feet_x = feet_mean(d, 0);
       s.touchdown_feet_y = feet_mean(d, 1);
       s.touchdown_feet_z = feet_mean(d, 2);
+      decide_if(touchdown_bound(task_, s) > 0);
     }
 
     // Obstacle proximity (contacts in the margin gap included).
@@ -89,6 +96,11 @@ class JumpHooks : public StepHooks {
         }
       }
     }
+
+    // Constraints that can only get worse: obstacle clearance and forward pitch.
+    const TaskConstraints& c = task_.constraints;
+    decide_if((c.clearance && s.min_clearance < c.min_clearance) ||
+              (c.pitch && s.max_forward_pitch > c.max_pitch));
 
     // Falls.
     if (contacts_.non_foot) return fall(t, "a body other than the feet touched the ground or an object", d);
@@ -198,7 +210,12 @@ class JumpHooks : public StepHooks {
   Evaluation& out_;
   const int rise_, fall_, land_;  // the controller's airborne phases and landing
   ContactState contacts_;
+  void decide_if(bool cannot_meet) {
+    if (cannot_meet && decided_ < 0) decided_ = index_;
+  }
+
   bool first_ = true;
+  long index_ = 0, decided_ = -1;  // steps observed; when the outcome was decided
   double pitch0_ = 0, pitch_takeoff_ = 0, last_pitch_ = 0, free_pitch_ = 0;
   double up0_[3] = {0, 0, 1}, fwd0_[3] = {1, 0, 0};  // free root: standing axes in its frame
   double elevation0_ = 0;                            // rad, the standing forward axis's
@@ -312,30 +329,10 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
   const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
   JointDrive drive = make_drive(body);
   controller->start_state(m, worker.data());
-  if (task_.walk.enabled) return evaluate_walk(*controller, drive, body, worker, options);
-  e.flight_time.reserve(1024);
-  e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
-  JumpHooks hooks(task_, body, *controller, drive, obstacle_geom_, e);
-  const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
-  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
-  e.phases = controller->phase_times();
-  if (e.stats.unstable) {
-    e.failed = true;
-    e.failure = "simulation unstable: " + e.stats.instability;
-    e.summary.unstable = true;
-  }
-  e.report = evaluate_constraints(task_, e.summary);
-  e.constraint = e.report.total;
-  e.fell = e.report.fell;
-  if (!e.failed && options.samples_per_phase > 0 && e.has_flight() && e.summary.landed) {
-    std::vector<double> taus;
-    for (int k = 0; k < options.samples_per_phase; ++k) {
-      taus.push_back((k + 0.5) / options.samples_per_phase);
-    }
-    for (int phase = 0; phase < 2; ++phase) {
-      auto poses = sample_poses(e, phase, taus, worker);
-      e.poses.insert(e.poses.end(), poses.begin(), poses.end());
-    }
+  if (task_.walk.enabled) {
+    e = evaluate_walk(*controller, drive, body, worker, options);
+  } else {
+    e = evaluate_jump(*controller, drive, body, worker, options);
   }
   if (options.half_timestep_check && task_.constraints.half_timestep && !e.failed && e.constraint == 0) {
     EvaluationOptions fine_options;
@@ -346,6 +343,41 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
     e.report.terms.push_back(term);
     e.report.total += term.penalty;
     e.constraint = e.report.total;
+    e.check_steps = fine.stats.steps;
+  }
+  return e;
+}
+
+Evaluation TaskEvaluator::evaluate_jump(Controller& controller, JointDrive& drive, const Character& body,
+                                        SimWorker& worker, const EvaluationOptions& options) const {
+  Evaluation e;
+  mjModel* m = worker.model();
+  e.flight_time.reserve(1024);
+  e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
+  JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, e);
+  const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
+  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  e.phases = controller.phase_times();
+  if (e.stats.unstable) {
+    e.failed = true;
+    e.failure = "simulation unstable: " + e.stats.instability;
+    e.summary.unstable = true;
+  }
+  e.report = evaluate_constraints(task_, e.summary);
+  e.constraint = e.report.total;
+  e.fell = e.report.fell;
+  e.decided_step = static_cast<int>(hooks.decided_at());
+  if (hooks.decided_at() >= 0)
+    e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
+  if (!e.failed && options.samples_per_phase > 0 && e.has_flight() && e.summary.landed) {
+    std::vector<double> taus;
+    for (int k = 0; k < options.samples_per_phase; ++k) {
+      taus.push_back((k + 0.5) / options.samples_per_phase);
+    }
+    for (int phase = 0; phase < 2; ++phase) {
+      auto poses = sample_poses(e, phase, taus, worker);
+      e.poses.insert(e.poses.end(), poses.begin(), poses.end());
+    }
   }
   return e;
 }
@@ -366,6 +398,9 @@ Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& driv
   e.report = evaluate_constraints(task_, e.summary);
   e.constraint = e.report.total;
   e.fell = e.report.fell;
+  e.decided_step = static_cast<int>(hooks.decided_at());
+  if (hooks.decided_at() >= 0)
+    e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
   if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);
   return e;
 }

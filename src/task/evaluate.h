@@ -50,11 +50,12 @@ struct EvaluationOptions {
   // The rollout runs at the model's timestep times this (the worker's model copy is
   // changed for the rollout only; SimWorker::reset restores it).
   double timestep_scale = 1.0;
-  // When the task asks for the half-timestep check ([constraints] half_timestep, a jump
-  // task) and the motion meets the task, simulate it again on the same worker with the
-  // timestep halved and add the term "half_timestep" (task/constraints.h) to its report
-  // and C. Off by default: the optimizer's samples, `diverse simulate` and the motion
-  // files of a run ask for it; the input-motion search checks both timesteps itself.
+  // When the task asks for the half-timestep check ([constraints] half_timestep) and the
+  // motion meets the task, simulate it again on the same worker with the timestep halved
+  // and add the term "half_timestep" (task/constraints.h) to its report and C. Off by
+  // default: `diverse simulate` and the motion files of a run ask for it; the optimizer
+  // asks for it only where it decides something (eval/motion_problem.h, confirm()); the
+  // input-motion search checks both timesteps itself.
   bool half_timestep_check = false;
 };
 
@@ -67,6 +68,16 @@ struct Evaluation {
   MotionSummary summary;
   PhaseTimes phases;         // phase start times (s)
   RolloutStats stats;
+  // The steps simulated after the outcome was decided: after the moment from which the
+  // motion could no longer meet the task (a landing outside the box at touch-down, an
+  // obstacle touched, a walk step out of its range; task/constraints.h,
+  // touchdown_bound()), up to the end of the rollout; decided_step is that moment in
+  // steps observed (-1: never, and so 0 steps after it). A motion that meets the task is
+  // never decided before its end.
+  int decided_step = -1;
+  int steps_after_decided = 0;
+  // The half-timestep check's rollout, when one ran (half_timestep_check): its steps.
+  int check_steps = 0;
   // Airborne states, take-off to landing inclusive: time (s) and qpos (nq per entry).
   std::vector<double> flight_time, flight_qpos;
   std::vector<PoseSample> poses;  // 2 * samples_per_phase when the jump took off and landed
@@ -175,6 +186,9 @@ class TaskEvaluator {
   // limit at strength 1; throws UserError naming an actuator whose limit did not scale.
   void check_strength() const;
 
+  // The rollout of a jump task, from the controller's start state.
+  Evaluation evaluate_jump(Controller& controller, JointDrive& drive, const Character& body,
+                           SimWorker& worker, const EvaluationOptions& options) const;
   // The rollout of a walk task (task/walk_eval.h), from the controller's start state.
   Evaluation evaluate_walk(Controller& controller, JointDrive& drive, const Character& body,
                            SimWorker& worker, const EvaluationOptions& options) const;

@@ -7,6 +7,7 @@
 
 #include "control/walk_controller.h"
 #include "task/walk_audit.h"
+#include "task/walk_task.h"
 
 namespace diverse {
 namespace {
@@ -157,6 +158,10 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
         step.tilt = tilt_;
         walk.steps.push_back(step);
         tilt_ = 0;
+        // Every evaluated step adds its excess to C, so one out of range decides it.
+        if (decided_ < 0 && static_cast<int>(walk.steps.size()) > w.settle_steps &&
+            walk_constraints(task_, s).total > 0)
+          decided_ = index_;
       }
       last_leg_ = f;
     }

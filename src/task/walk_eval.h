@@ -46,6 +46,10 @@ class WalkObserver : public StepHooks {
   // as scratch). Empty unless the walk took all its steps.
   std::vector<PoseSample> poses(SimWorker& worker) const;
 
+  // Steps observed, and when an evaluated step first broke the task's rules (-1: none).
+  long observed() const { return index_; }
+  long decided_at() const { return decided_; }
+
  private:
   bool fall(const mjData* d, const char* why);
   double heading(const mjData* d) const;  // rad, of the root, relative to standing
@@ -68,6 +72,7 @@ class WalkObserver : public StepHooks {
   double flight_start_ = -1;            // s, when both feet last left the ground; -1 if one is down
   // Steps from contacts.
   long index_ = 0;                       // simulation steps observed
+  long decided_ = -1;                    // index_ when a step first broke the rules, or -1
   std::array<bool, 2> ground_{true, true};  // each foot on something not the character
   std::array<double, 2> lifted_{0, 0};   // s (index x timestep), when each foot last left it
   int last_leg_ = -1;                    // the foot that made the last step

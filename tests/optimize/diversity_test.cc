@@ -673,3 +673,95 @@ TEST(DiversityCheckpoint, RejectsACheckpointOfAnotherProblem) {
 
 }  // namespace
 }  // namespace diverse
+
+namespace diverse {
+namespace {
+
+// The ball problem with a dear check: evaluate() gives points that meet the ball
+// constraint as provisional; confirm() finds that those with x[0] > 0.45 fail it (C =
+// 1 + how far past), as a motion that holds at its timestep may fail at half of it. The
+// ledger counts evaluations and confirmations.
+class CheckedBallProblem : public BallProblem {
+ public:
+  CheckedBallProblem() : BallProblem(3, 0.3) {}
+  std::shared_ptr<const Outcome> evaluate(const Eigen::VectorXd& x, int worker) const override {
+    auto out = std::make_shared<PointOutcome>(static_cast<const PointOutcome&>(*BallProblem::evaluate(x, worker)));
+    out->provisional = !out->failed && out->constraint == 0;
+    return out;
+  }
+  std::shared_ptr<const Outcome> confirm(const Eigen::VectorXd& x, const Outcome& outcome,
+                                         int) const override {
+    EXPECT_TRUE(outcome.provisional);
+    confirmations.fetch_add(1);
+    auto out = std::make_shared<PointOutcome>(static_cast<const PointOutcome&>(outcome));
+    EXPECT_EQ(out->x, x);
+    out->provisional = false;
+    if (x[0] > kLimit) out->constraint = 1 + (x[0] - kLimit);
+    return out;
+  }
+  void tally(const Outcome&, nlohmann::json& ledger) const override {
+    const long long total = ledger.is_object() ? ledger.value("total", 0LL) : 0LL;
+    ledger["total"] = total + 1;
+  }
+  static constexpr double kLimit = 0.45;
+  mutable std::atomic<long long> confirmations{0};
+};
+
+class Confirmation : public ::testing::TestWithParam<DiversityStrategy> {};
+
+TEST_P(Confirmation, EveryVariationStandsOnlyWhereItsCheckHolds) {
+  const CheckedBallProblem problem;
+  DiversityOptions o = small_options(GetParam(), 30);
+  o.point = VariationPoint::kBestSample;
+  ThreadPool two(2);
+  DiversityOptimizer opt(problem, o, two);
+  opt.run();
+  // Without the check, variations spread over the whole ball (x[0] up to 0.7); with it,
+  // every point of the result, and every point a path went through, passed it.
+  const DiversityResult r = opt.result();
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    EXPECT_LE(r.parameters[i][0], CheckedBallProblem::kLimit) << "M" << i;
+    EXPECT_FALSE(r.outcomes[i]->provisional) << "M" << i;
+    EXPECT_EQ(r.outcomes[i]->constraint, 0.0) << "M" << i;
+  }
+  for (const auto& path : opt.paths())
+    for (const PathPoint& p : path) EXPECT_LE(p.x[0], CheckedBallProblem::kLimit);
+  // The checks ran where they decided something: far fewer than the feasible samples.
+  long long feasible = 0;
+  for (const DiversityRecord& record : opt.log()) feasible += record.feasible;
+  EXPECT_GT(opt.confirmations(), 0);
+  EXPECT_EQ(opt.confirmations(), problem.confirmations.load());
+  // (The joint strategy scores whole sets, so it confirms every provisional motion.)
+  if (GetParam() != DiversityStrategy::kJoint) EXPECT_LT(opt.confirmations(), feasible / 2);
+  // Every evaluation and confirmation was tallied once.
+  EXPECT_EQ(opt.ledger().value("total", 0LL), opt.evaluations() + opt.confirmations());
+  EXPECT_EQ(opt.log().back().confirmations, opt.confirmations());
+}
+
+TEST_P(Confirmation, DeterministicAndResumable) {
+  const CheckedBallProblem problem;
+  for (VariationPoint point : {VariationPoint::kMean, VariationPoint::kBestSample}) {
+  SCOPED_TRACE(to_string(point));
+  DiversityOptions o = small_options(GetParam(), 16);
+  o.point = point;
+  ThreadPool one(1), three(3);
+  DiversityOptimizer a(problem, o, one), b(problem, o, three);
+  a.run();
+  b.run();
+  expect_identical(a, b);
+  DiversityOptimizer first(problem, o, one);
+  for (int g = 0; g < 7; ++g) first.step();
+  DiversityOptimizer resumed =
+      DiversityOptimizer::from_checkpoint(problem, nlohmann::json::parse(first.checkpoint().dump()), three);
+  EXPECT_EQ(resumed.confirmations(), first.confirmations());
+  EXPECT_EQ(resumed.ledger(), first.ledger());
+  resumed.run();
+  expect_identical(a, resumed);
+  EXPECT_EQ(resumed.ledger(), a.ledger());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, Confirmation, kAllStrategies, strategy_test_name);
+
+}  // namespace
+}  // namespace diverse

@@ -7,8 +7,11 @@
 // outcomes carrying the term.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 
+#include "core/rng.h"
 #include "eval/motion_problem.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
@@ -112,15 +115,34 @@ TEST(HalfTimestep, ScaledTimestepEqualsACompiledOneAndIsRestored) {
   EXPECT_EQ(worker->model()->opt.timestep, ev.model().get()->opt.timestep);
 }
 
-// The optimizer's outcomes carry the check: the motion that lands apart does not meet
-// the task as a sample of a diversity run.
-TEST(HalfTimestep, TheOptimizersSamplesAreChecked) {
+// The optimizer's samples carry the check once confirmed: the motion that lands apart
+// meets the task at its timestep, so its sample is provisional, and its confirmation
+// does not meet it. The confirmed outcome is the one the eager check gives, bit for bit,
+// and its steps are counted.
+TEST(HalfTimestep, TheOptimizersSamplesAreCheckedWhenConfirmed) {
   const Task task = load_task(kTasks + "jump_high.toml");
   const TaskEvaluator ev(task);
   const ParameterSet m0 = ev.load_parameters(task.m0);
   const MotionProblem problem(ev, Metric::kMassDistance, m0.normalized(), 1);
-  EXPECT_EQ(problem.evaluate(m0.normalized(), 0)->constraint, 0.0);
-  EXPECT_GT(problem.evaluate(ev.load_parameters(kLandsApart).normalized(), 0)->constraint, 0.0);
+  const Eigen::VectorXd apart = ev.load_parameters(kLandsApart).normalized();
+  for (const Eigen::VectorXd& x : {m0.normalized(), apart}) {
+    const auto coarse = problem.evaluate(x, 0);
+    EXPECT_TRUE(coarse->provisional);
+    EXPECT_EQ(coarse->constraint, 0.0);
+    const auto confirmed = problem.confirm(x, *coarse, 0);
+    EXPECT_FALSE(confirmed->provisional);
+    auto worker = ev.make_worker();
+    const Evaluation eager = ev.evaluate_normalized(x, *worker, checked());
+    EXPECT_EQ(confirmed->constraint, eager.constraint);
+    EXPECT_EQ(static_cast<const MotionOutcome&>(*confirmed).check_steps, eager.check_steps);
+    EXPECT_GT(eager.check_steps, eager.stats.steps);
+    EXPECT_EQ(problem.evaluate_confirmed(x, 0)->constraint, eager.constraint);
+  }
+  EXPECT_EQ(problem.evaluate_confirmed(m0.normalized(), 0)->constraint, 0.0);
+  EXPECT_GT(problem.evaluate_confirmed(apart, 0)->constraint, 0.0);
+  // Confirming what is not provisional is a programming error.
+  const auto done = problem.evaluate_confirmed(apart, 0);
+  EXPECT_THROW(problem.confirm(apart, *done, 0), std::logic_error);
 }
 
 // The standing centre of mass is the start pose's, the same for any controller
@@ -153,6 +175,59 @@ TEST(HalfTimestep, StandingComMovesWithTheBody) {
   const ConstraintTerm* term = find_term(tall, "peak_height");
   ASSERT_NE(term, nullptr);
   EXPECT_NEAR(term->violation, std::max(0.0, required - tall.summary.peak_com_z), 1e-12);
+}
+
+}  // namespace
+}  // namespace diverse
+
+namespace diverse {
+namespace {
+
+// A rollout's outcome is decided only when it can no longer meet the task: over M0 and
+// its neighbourhood, every rollout decided before its end misses the task, and M0 is
+// never decided. A landing box moved away from M0's landing decides it at touch-down.
+TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
+  for (const char* name : {"jump_forward.toml", "jump_over.toml", "jump_high.toml"}) {
+    SCOPED_TRACE(name);
+    Task task = load_task(kTasks + name);
+    const TaskEvaluator ev(task);
+    const ParameterSet m0 = ev.load_parameters(task.m0);
+    auto worker = ev.make_worker();
+    EvaluationOptions plain;
+    plain.samples_per_phase = 0;
+    const Evaluation e0 = ev.evaluate(m0.values(), *worker, plain);
+    ASSERT_EQ(e0.constraint, 0.0);
+    EXPECT_EQ(e0.decided_step, -1);
+    EXPECT_EQ(e0.steps_after_decided, 0);
+    Rng rng(derive_seed(3, {static_cast<std::uint64_t>(std::string(name).size())}));
+    int decided = 0;
+    for (int k = 0; k < 24; ++k) {
+      Eigen::VectorXd x = m0.normalized();
+      for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j] + 0.05 * rng.normal(), 0.0, 1.0);
+      const Evaluation e = ev.evaluate_normalized(x, *worker, plain);
+      if (e.decided_step >= 0) {
+        ++decided;
+        EXPECT_GT(e.constraint, 0.0) << "sample " << k;
+        EXPECT_LE(e.decided_step, e.stats.steps + 1);
+        EXPECT_NEAR(e.steps_after_decided, std::max(0, e.stats.steps + 1 - e.decided_step), 1);
+      }
+    }
+    EXPECT_GT(decided, 0);
+  }
+  // The landing box a metre further on: M0 lands short of it, decided at touch-down.
+  Task task = load_task(kTasks + "jump_forward.toml");
+  task.constraints.landing_center += 1.0;
+  const TaskEvaluator ev(task);
+  auto worker = ev.make_worker();
+  EvaluationOptions plain;
+  plain.samples_per_phase = 0;
+  const Evaluation e = ev.evaluate(ev.load_parameters(task.m0).values(), *worker, plain);
+  EXPECT_GT(e.constraint, 0.0);
+  EXPECT_FALSE(e.fell);
+  ASSERT_GE(e.decided_step, 0);
+  const double touchdown = e.phases.landing();
+  EXPECT_NEAR(e.decided_step * ev.model().get()->opt.timestep, touchdown, 2.5 * ev.model().get()->opt.timestep);
+  EXPECT_GT(e.steps_after_decided, 100);  // it still comes to rest, as C asks
 }
 
 }  // namespace

@@ -338,3 +338,49 @@ TEST(WalkEvaluation, FallEndsTheRollout) {
 
 }  // namespace
 }  // namespace diverse
+
+namespace diverse {
+namespace {
+
+// Walks are judged at half their timestep too: the committed input walks meet their
+// tasks at half the step (the check adds a "half_timestep" term of 0 and counts the
+// check's steps, about twice the walk's), and a walk whose step breaks the rules at half
+// the step does not meet the task. Steps past a rule broken in the evaluated window are
+// counted as decided.
+TEST(WalkHalfTimestep, InputWalksHoldAtHalfTheStep) {
+  for (const char* name : {"silly_walk.toml", "robot_silly_walk.toml"}) {
+    SCOPED_TRACE(name);
+    Task task = load_task(kTasks + name);
+    task.constraints.half_timestep = true;
+    const TaskEvaluator ev(task);
+    const ParameterSet m0 = ev.load_parameters(task.m0);
+    EvaluationOptions checked;
+    checked.samples_per_phase = 0;
+    checked.half_timestep_check = true;
+    const Evaluation e = ev.evaluate(m0.values(), *ev.make_worker(), checked);
+    EXPECT_EQ(e.constraint, 0.0);
+    EXPECT_EQ(e.decided_step, -1);
+    const auto term = std::find_if(e.report.terms.begin(), e.report.terms.end(),
+                                   [](const ConstraintTerm& t) { return t.name == "half_timestep"; });
+    ASSERT_NE(term, e.report.terms.end());
+    EXPECT_EQ(term->penalty, 0.0);
+    EXPECT_GT(e.check_steps, 1.8 * e.stats.steps);
+    EXPECT_LT(e.check_steps, 2.2 * e.stats.steps);
+
+    // Narrow the forward range to exclude the input walk's steps: it no longer meets the
+    // task, the outcome is decided at the first evaluated step, and no check runs.
+    task.walk.forward_half_width = 0.01;
+    task.walk.forward_center = 3.0;
+    const TaskEvaluator narrow(task);
+    const Evaluation n = narrow.evaluate(m0.values(), *narrow.make_worker(), checked);
+    EXPECT_GT(n.constraint, 0.0);
+    EXPECT_EQ(n.check_steps, 0);
+    ASSERT_GE(n.decided_step, 0);
+    EXPECT_GT(n.steps_after_decided, 0);
+    EXPECT_NEAR(n.decided_step * narrow.model().get()->opt.timestep,
+                n.summary.walk.steps[static_cast<size_t>(task.walk.settle_steps)].time, 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace diverse
