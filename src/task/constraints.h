@@ -50,6 +50,10 @@ struct MotionSummary {
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
+  // The rollout was ended once the motion had landed and could no longer meet the task
+  // (EvaluationOptions::end_when_decided): the feet "at rest" are where they were then,
+  // and the rotation from standing to standing, known only at rest, counts as met.
+  bool ended_decided = false;
   WalkSummary walk;           // a walk task's steps (task/walk_task.h)
 };
 

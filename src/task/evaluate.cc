@@ -18,9 +18,9 @@ namespace {
 class JumpHooks : public StepHooks {
  public:
   JumpHooks(const Task& task, const Character& body, Controller& controller, JointDrive& drive,
-            int obstacle_geom, Evaluation& out)
+            int obstacle_geom, bool end_when_decided, Evaluation& out)
       : task_(task), body_(body), controller_(controller), drive_(drive), obstacle_(obstacle_geom),
-        out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
+        end_when_decided_(end_when_decided), out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
         land_(controller.phase_times().land) {
     out_.summary.min_clearance = task.simulation.clearance_range;
   }
@@ -101,6 +101,12 @@ class JumpHooks : public StepHooks {
     const TaskConstraints& c = task_.constraints;
     decide_if((c.clearance && s.min_clearance < c.min_clearance) ||
               (c.pitch && s.max_forward_pitch > c.max_pitch));
+    if (end_when_decided_ && decided_ >= 0 && s.landed) {
+      finish(t, d);
+      s.ended_decided = true;
+      s.rotation_total = 2 * M_PI * c.rotation_turns;
+      return true;
+    }
 
     // Falls.
     if (contacts_.non_foot) return fall(t, "a body other than the feet touched the ground or an object", d);
@@ -207,6 +213,7 @@ class JumpHooks : public StepHooks {
   Controller& controller_;
   JointDrive& drive_;
   int obstacle_;
+  bool end_when_decided_;
   Evaluation& out_;
   const int rise_, fall_, land_;  // the controller's airborne phases and landing
   ContactState contacts_;
@@ -354,7 +361,7 @@ Evaluation TaskEvaluator::evaluate_jump(Controller& controller, JointDrive& driv
   mjModel* m = worker.model();
   e.flight_time.reserve(1024);
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
-  JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, e);
+  JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
   e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
   e.phases = controller.phase_times();

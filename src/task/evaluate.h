@@ -57,6 +57,13 @@ struct EvaluationOptions {
   // asks for it only where it decides something (eval/motion_problem.h, confirm()); the
   // input-motion search checks both timesteps itself.
   bool half_timestep_check = false;
+  // End a jump's rollout as soon as it has landed and its outcome is decided (see
+  // Evaluation::steps_after_decided; MotionSummary::ended_decided): its C is then what was
+  // known at that moment, every term the rest could only make worse (touchdown_bound()),
+  // without a later fall. A motion that meets the task is never ended, so it is simulated
+  // exactly as without the option. The optimizer's samples use it; `diverse simulate` and
+  // motion files do not.
+  bool end_when_decided = false;
 };
 
 struct Evaluation {

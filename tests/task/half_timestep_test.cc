@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
+#include <vector>
 #include <string>
 
 #include "core/rng.h"
@@ -214,6 +216,50 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
     }
     EXPECT_GT(decided, 0);
   }
+  // Ended when decided (the optimizer's samples): a motion that meets the task runs as
+  // before, bit for bit; one that is ended still misses it, with a C no larger than its
+  // full rollout's (what the rest could only add is left out), in nearly the same order.
+  {
+    const Task task = load_task(kTasks + "jump_forward.toml");
+    const TaskEvaluator ev(task);
+    const ParameterSet m0 = ev.load_parameters(task.m0);
+    auto worker = ev.make_worker();
+    EvaluationOptions full, ended;
+    full.samples_per_phase = ended.samples_per_phase = 10;
+    ended.end_when_decided = true;
+    Rng rng(derive_seed(5, {1}));
+    std::vector<double> c_full, c_ended;
+    int count_ended = 0;
+    for (int k = 0; k < 40; ++k) {
+      Eigen::VectorXd x = m0.normalized();
+      if (k > 0)
+        for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j] + 0.03 * rng.normal(), 0.0, 1.0);
+      const Evaluation a = ev.evaluate_normalized(x, *worker, full);
+      const Evaluation b = ev.evaluate_normalized(x, *worker, ended);
+      if (!b.summary.ended_decided) {
+        EXPECT_EQ(a.constraint, b.constraint) << "sample " << k;
+        EXPECT_EQ(a.stats.steps, b.stats.steps) << "sample " << k;
+        EXPECT_EQ(a.poses.size(), b.poses.size());
+        continue;
+      }
+      ++count_ended;
+      EXPECT_GT(b.constraint, 0.0) << "sample " << k;
+      EXPECT_LE(b.constraint, a.constraint) << "sample " << k;
+      EXPECT_LT(b.stats.steps, a.stats.steps) << "sample " << k;
+      c_full.push_back(a.constraint);
+      c_ended.push_back(b.constraint);
+    }
+    EXPECT_GT(count_ended, 3);
+    // Pairs of ended samples in the same order by either C.
+    int pairs = 0, same = 0;
+    for (std::size_t i = 0; i < c_full.size(); ++i)
+      for (std::size_t j = i + 1; j < c_full.size(); ++j) {
+        ++pairs;
+        same += (c_full[i] < c_full[j]) == (c_ended[i] < c_ended[j]);
+      }
+    std::printf("ended %d of 40; %d of %d pairs in the same order\n", count_ended, same, pairs);
+  }
+
   // The landing box a metre further on: M0 lands short of it, decided at touch-down.
   Task task = load_task(kTasks + "jump_forward.toml");
   task.constraints.landing_center += 1.0;
