@@ -278,19 +278,19 @@ std::string robustness_shares(const nlohmann::json& motion, const std::string& o
       {"parameters", "params"}, {"pushes", "pushes"}, {"friction", "friction"}, {"half_timestep", "half-step"}};
   auto count = [&](const nlohmann::json& j, const char* key, const std::string& field) {
     if (!j.is_object() || !j.contains(key) || !j[key].is_number_integer() || j[key].get<long long>() < 0)
-      throw_field_error(origin, field + "." + key, "a count (an integer >= 0)");
+      throw_field_error(origin, field + "." + key, "expected a count (an integer >= 0)");
     return j[key].get<long long>();
   };
   if (!motion.is_object() || !motion.contains("kinds") || !motion["kinds"].is_object())
-    throw_field_error(origin, "motions[].kinds", "the counts of every kind of perturbation");
+    throw_field_error(origin, "motions[].kinds", "expected the counts of every kind of perturbation");
   std::string text;
   long long held = 0, total = 0;
   for (const auto& [key, name] : kShort) {
     const std::string field = std::string("motions[].kinds.") + key;
-    if (!motion["kinds"].contains(key)) throw_field_error(origin, field, "the counts of this kind");
+    if (!motion["kinds"].contains(key)) throw_field_error(origin, field, "expected the counts of this kind");
     const nlohmann::json& k = motion["kinds"][key];
     const long long h = count(k, "held", field), c = count(k, "count", field);
-    if (h > c) throw_field_error(origin, field + ".held", "at most its count");
+    if (h > c) throw_field_error(origin, field + ".held", "expected at most its count");
     char buffer[64];
     std::snprintf(buffer, sizeof buffer, "%s%s %lld/%lld", text.empty() ? "" : ", ", name, h, c);
     text += buffer;
