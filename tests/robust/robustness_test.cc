@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/thread_pool.h"
+#include "eval/motion_problem.h"
 #include "robust/robustness.h"
 #include "task/evaluate.h"
 
@@ -97,10 +98,27 @@ TEST(Push, NeverAppliedUnlessAsked) {
   mjModel* m = mj_copyModel(nullptr, f.ev.model().get());
   EXPECT_EQ(replay(m, record), 0.0);
   mj_deleteModel(m);
+  // A push of 0 m/s is applied (the velocity-dependent terms computed again) and changes
+  // nothing either.
+  EvaluationOptions zero = plain();
+  zero.push.time = 0.5 * a.phases.takeoff();
+  const Evaluation c = f.ev.evaluate(f.m0.values(), *worker, zero);
+  EXPECT_GE(c.push_time, zero.push.time);
+  EXPECT_TRUE(same_bits(a.constraint, c.constraint));
+  EXPECT_EQ(a.stats.steps, c.stats.steps);
+  EXPECT_TRUE(same_bits(a.stats.effort, c.stats.effort));
+  EXPECT_TRUE(same_bits(a.summary.feet_x, c.summary.feet_x));
   // A pushed rollout cannot be recorded: its record would not replay.
   EvaluationOptions both = never;
   both.recorder = &record;
   EXPECT_THROW(f.ev.evaluate(f.m0.values(), *worker, both), std::logic_error);
+  // Nor does the optimizer's problem take a push or a friction scale.
+  const MotionProblem problem(f.ev, parse_distance("md"), f.m0.normalized(), 1);
+  EXPECT_THROW(problem.simulate(f.m0.normalized(), never), std::logic_error);
+  EvaluationOptions icy = plain();
+  icy.friction_scale = 0.5;
+  EXPECT_THROW(problem.simulate(f.m0.normalized(), icy), std::logic_error);
+  EXPECT_EQ(problem.simulate(f.m0.normalized(), plain()).constraint, a.constraint);
 }
 
 TEST(Friction, ChangesTheMotionAndIsRestoredAfter) {
