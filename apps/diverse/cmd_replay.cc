@@ -10,7 +10,9 @@
 // (task/walk_audit.h): steps counted from foot contacts, every step's length in the
 // heading frame, pelvis and torso tilt, falls and the turn, against the task's [walk]
 // rules; one line per step and exit 1 on a broken rule. The task file is --task, else the
-// run's (RUN/run.json beside motions/), else tasks/<task>.toml.
+// run's (RUN/run.json beside motions/), else tasks/<task>.toml. A --task for another
+// controller or character than the motion's is refused before anything is replayed: one
+// line naming the motion file, the field (parameters, replay.model) and what was expected.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -24,6 +26,7 @@
 #include "io/motion_record.h"
 #include "physics/drive.h"
 #include "physics/model.h"
+#include "task/evaluate.h"
 #include "task/task.h"
 #include "task/walk_audit.h"
 
@@ -70,6 +73,49 @@ std::string walk_task_file(const std::string& motion_path, const nlohmann::json&
   }
 }
 
+// With --task: the task must be for the motion's controller and character, or the
+// replay would be judged against rules of another skill. The motion's parameters must be
+// exactly the task's controller's for its character (shape scales aside), and the
+// motion's saved model must have the task scene's joints, in order.
+void check_task_of_motion(const std::string& path, const std::string& task_option) {
+  const nlohmann::json motion = read_json(path);
+  const Task task = load_task(resolve_task_path(task_option));
+  const TaskEvaluator ev(task);
+  const std::string of_task = " (task " + task.file + ")";
+  const std::string motion_task = motion.is_object() ? motion.value("task", std::string("?")) : std::string("?");
+  const std::string expected = "expected the parameters of controller '" + task.controller + "' for character '" +
+                               task.character_spec->name + "'" + of_task;
+  if (!motion.is_object() || !motion.contains("parameters") || !motion["parameters"].is_object())
+    throw_field_error(path, "parameters", expected);
+  const nlohmann::json& named = motion["parameters"];
+  std::size_t control = 0;
+  for (const auto& [name, value] : named.items()) {
+    if (name.rfind("shape.", 0) == 0) continue;
+    ++control;
+    if (ev.parameters().find(name) < 0)
+      throw_field_error(path, "parameters", expected + ", got '" + name + "' of a motion of task '" + motion_task + "'");
+  }
+  if (static_cast<int>(control) != ev.dim())
+    throw_field_error(path, "parameters",
+                      expected + ": " + std::to_string(ev.dim()) + " of them, got " + std::to_string(control) +
+                          " of a motion of task '" + motion_task + "'");
+  std::filesystem::path model_path;
+  read_replay_record(motion, path, &model_path);
+  const auto saved = SharedModel::from_file(model_path.string());
+  const mjModel* a = saved->get();
+  const mjModel* b = ev.model().get();
+  bool same = a->njnt == b->njnt;
+  for (int j = 0; same && j < a->njnt; ++j) {
+    const char* na = mj_id2name(a, mjOBJ_JOINT, j);
+    const char* nb = mj_id2name(b, mjOBJ_JOINT, j);
+    same = std::string(na ? na : "") == std::string(nb ? nb : "") && a->jnt_type[j] == b->jnt_type[j];
+  }
+  if (!same)
+    throw_field_error(path, "replay.model",
+                      "expected a model of character '" + task.character_spec->name + "'" + of_task +
+                          " (its joints, in order), got a model of task '" + motion_task + "'");
+}
+
 // Prints the audit of a walk motion; returns false if it breaks a rule of its task.
 bool audit_walk_motion(const std::string& path, const std::string& task_option) {
   const nlohmann::json motion = read_json(path);
@@ -110,6 +156,7 @@ void install(CLI::App& app) {
   cmd->add_option("--task", *task,
                   "Task file whose [walk] rules a walk is audited against (default: the run's, else tasks/<task>.toml)");
   cmd->callback([path, task] {
+    if (!task->empty()) check_task_of_motion(*path, *task);
     int steps = 0;
     const double diff = replay_motion_file(*path, &steps);
     std::printf("replayed %d steps, max |qpos difference| = %.3g\n", steps, diff);

@@ -1,5 +1,8 @@
 // `diverse report RUN...`: one Markdown table row per finished run, read from the runs'
-// summary.json files. Used by the reproduction scripts in scripts/.
+// summary.json files. Used by the reproduction scripts in scripts/. Runs whose
+// robustness was measured (RUN/robustness.json, `diverse robustness RUN`) add a second
+// table after it: per motion, the share of perturbed rollouts of each kind that meet
+// the task (robust/robustness.h).
 //
 //   diverse report runs/repro/*
 #include <CLI/CLI.hpp>
@@ -13,6 +16,7 @@
 #include "options.h"
 #include "core/error.h"
 #include "io/files.h"
+#include "robust/robustness.h"
 
 namespace diverse::cli {
 namespace {
@@ -29,9 +33,27 @@ void install_report(CLI::App& app) {
   cmd->add_option("runs", *runs, "Run directories")->required();
   cmd->callback([runs] {
     // Every directory is checked before the table starts, so an error is the only output.
+    // The robustness of a run's motions (RUN/robustness.json, `diverse robustness RUN`) is
+    // read now too, and tabled after the runs: per motion, the share of each kind of
+    // perturbed rollouts that meet the task.
+    std::vector<std::string> robustness_rows;
     for (const std::string& dir : *runs) {
       if (!std::filesystem::exists(std::filesystem::path(dir) / "summary.json"))
         throw UserError(dir + ": not a finished run (no summary.json)");
+      const std::filesystem::path file = std::filesystem::path(dir) / "robustness.json";
+      if (!std::filesystem::exists(file)) continue;
+      const nlohmann::json r = read_json(file);
+      if (!r.is_object() || r.value("format", std::string()) != "diverse.robustness")
+        throw_field_error(file.string(), "format", "expected \"diverse.robustness\" (written by `diverse robustness`)");
+      if (!r.contains("motions") || !r["motions"].is_array())
+        throw_field_error(file.string(), "motions", "expected a list of motions");
+      for (const nlohmann::json& m : r["motions"]) {
+        if (!m.is_object() || !m.contains("label") || !m["label"].is_string())
+          throw_field_error(file.string(), "motions[].label", "expected a motion's label");
+        robustness_rows.push_back("| " + std::filesystem::path(dir).filename().string() + " | " +
+                                  m["label"].get<std::string>() + " | " +
+                                  robustness_shares(m, file.string()) + " |");
+      }
     }
     std::printf(
         "| run | task | metric | strategy | seed | generations | minutes | D | C of M1..MN | "
@@ -75,6 +97,10 @@ void install_report(CLI::App& app) {
         throw UserError(summary_path.string() + ": expected a summary written by `diverse run` (" +
                         e.what() + ")");
       }
+    }
+    if (!robustness_rows.empty()) {
+      std::printf("\n| run | motion | robustness (perturbed rollouts that meet the task) |\n|---|---|---|\n");
+      for (const std::string& row : robustness_rows) std::printf("%s\n", row.c_str());
     }
   });
 }

@@ -292,6 +292,9 @@ Evaluation MotionProblem::run(const Eigen::VectorXd& x, int worker, const Evalua
 
 Evaluation MotionProblem::simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
                                    std::shared_ptr<const SharedModel>* model_out) const {
+  // The robustness suite's disturbances (robust/robustness.h) are never the optimizer's.
+  if (options.push.time >= 0 || options.friction_scale != 1.0)
+    throw std::logic_error("MotionProblem::simulate: a push or a friction scale is the robustness suite's only");
   return evaluator_->evaluate_named(named(x), options, model_out);
 }
 

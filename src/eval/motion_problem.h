@@ -141,7 +141,8 @@ class MotionProblem : public DiversityProblem {
   // A normalized vector as named values.
   ParameterSet named(const Eigen::VectorXd& x) const;
   // Simulates x again on a worker of its own (thread-safe) with the options' recorder;
-  // `model_out` receives the model it ran on (the shaped scene's with vary_shape).
+  // `model_out` receives the model it ran on (the shaped scene's with vary_shape). The
+  // suite's push and friction scale (EvaluationOptions) are refused: std::logic_error.
   Evaluation simulate(const Eigen::VectorXd& x, const EvaluationOptions& options,
                       std::shared_ptr<const SharedModel>* model_out = nullptr) const;
 

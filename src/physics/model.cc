@@ -86,6 +86,7 @@ SimWorker::~SimWorker() {
 void SimWorker::reset() {
   const mjModel* src = shared_->get();
   std::memcpy(model_->dof_damping, src->dof_damping, sizeof(mjtNum) * src->nv);
+  std::memcpy(model_->geom_friction, src->geom_friction, sizeof(mjtNum) * 3 * src->ngeom);
   model_->opt.timestep = src->opt.timestep;
   mj_resetData(model_, data_);
 }

@@ -6,7 +6,9 @@
 // integrator treats it implicitly, see assets/characters/human2d.xml), so each worker
 // also owns a private copy of the model (mj_copyModel, about a microsecond) whose
 // dof_damping the controller writes; SimWorker::reset() restores it from the shared
-// model, and the step recorder logs every change so a replay can repeat it.
+// model, and the step recorder logs every change so a replay can repeat it. The
+// robustness suite (robust/robustness.h) also scales a rollout's timestep and friction on
+// that copy; reset() restores them as well.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -50,8 +52,9 @@ class SimWorker {
   SimWorker(const SimWorker&) = delete;
   SimWorker& operator=(const SimWorker&) = delete;
 
-  // Restores the private model's writable parameters (dof_damping, opt.timestep) from
-  // the shared model and resets mjData to qpos0 with zero velocity, time and warnings.
+  // Restores the private model's writable parameters (dof_damping, geom_friction,
+  // opt.timestep) from the shared model and resets mjData to qpos0 with zero velocity,
+  // time and warnings.
   void reset();
 
   const SharedModel& shared() const { return *shared_; }

@@ -228,6 +228,55 @@ class JumpHooks : public StepHooks {
   double elevation0_ = 0;                            // rad, the standing forward axis's
 };
 
+// Puts the worker's geom friction back to the shared model's when it goes out of scope.
+class FrictionRestore {
+ public:
+  FrictionRestore(SimWorker& worker, bool active) : worker_(worker), active_(active) {}
+  ~FrictionRestore() {
+    if (!active_) return;
+    const mjModel* src = worker_.shared().get();
+    mju_copy(worker_.model()->geom_friction, src->geom_friction, 3 * src->ngeom);
+  }
+  FrictionRestore(const FrictionRestore&) = delete;
+  FrictionRestore& operator=(const FrictionRestore&) = delete;
+
+ private:
+  SimWorker& worker_;
+  bool active_;
+};
+
+// The push of EvaluationOptions::push around a rollout's own hooks: at the first step
+// whose time reaches the push's, the root's linear velocity changes by dv, and what
+// mj_step1 computed from the velocity (actuator and COM velocities, passive and bias
+// forces, the constraints' reference) is computed again, so the step, the controller and
+// the observer all see the pushed state. Nothing allocates; without a push it only forwards.
+class PushHooks : public StepHooks {
+ public:
+  PushHooks(StepHooks& inner, const Character& body, const EvaluationOptions::Push& push, Evaluation& out)
+      : inner_(inner), body_(body), push_(push), out_(out) {}
+
+  void control(mjModel* m, mjData* d) override {
+    if (push_.time >= 0 && out_.push_time < 0 && d->time >= push_.time) {
+      if (body_.root == RootKind::kPlanar) {
+        d->qvel[body_.root_x_dof] += push_.dv[0];
+        d->qvel[body_.root_z_dof] += push_.dv[2];
+      } else {
+        for (int k = 0; k < 3; ++k) d->qvel[body_.root_dof + k] += push_.dv[static_cast<size_t>(k)];
+      }
+      mj_fwdVelocity(m, d);
+      out_.push_time = d->time;
+    }
+    inner_.control(m, d);
+  }
+  bool observe(const mjModel* m, const mjData* d) override { return inner_.observe(m, d); }
+
+ private:
+  StepHooks& inner_;
+  const Character& body_;
+  const EvaluationOptions::Push& push_;
+  Evaluation& out_;
+};
+
 }  // namespace
 
 TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
@@ -333,6 +382,18 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
     throw std::logic_error("TaskEvaluator::evaluate: timestep_scale must be positive");
   }
   m->opt.timestep *= options.timestep_scale;
+  if (!(options.friction_scale > 0) || !std::isfinite(options.friction_scale)) {
+    throw std::logic_error("TaskEvaluator::evaluate: friction_scale must be positive");
+  }
+  const bool perturbed = options.friction_scale != 1.0 || options.push.time >= 0;
+  if (perturbed && options.recorder != nullptr) {
+    throw std::logic_error("TaskEvaluator::evaluate: a pushed or friction-scaled rollout cannot be recorded");
+  }
+  if (options.friction_scale != 1.0) {
+    for (int k = 0; k < 3 * m->ngeom; ++k) m->geom_friction[k] *= options.friction_scale;
+  }
+  // The scaled friction lasts for this rollout only (SimWorker::reset restores it too).
+  const FrictionRestore restore_friction(worker, options.friction_scale != 1.0);
   const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
   JointDrive drive = make_drive(body);
   controller->start_state(m, worker.data());
@@ -345,6 +406,9 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
     EvaluationOptions fine_options;
     fine_options.samples_per_phase = 0;
     fine_options.timestep_scale = 0.5 * options.timestep_scale;
+    // The same world: the suite's friction and push hold at the finer timestep too.
+    fine_options.friction_scale = options.friction_scale;
+    fine_options.push = options.push;
     const Evaluation fine = evaluate_on(values, body, worker, fine_options);
     const ConstraintTerm term = half_timestep_term(task_, e.summary, fine.summary, fine.constraint);
     e.report.terms.push_back(term);
@@ -363,7 +427,12 @@ Evaluation TaskEvaluator::evaluate_jump(Controller& controller, JointDrive& driv
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
   JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
-  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  if (options.push.time >= 0) {
+    PushHooks pushed(hooks, body, options.push, e);
+    e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
+  } else {
+    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  }
   e.phases = controller.phase_times();
   if (e.stats.unstable) {
     e.failed = true;
@@ -395,7 +464,12 @@ Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& driv
   mjModel* m = worker.model();
   WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, e);
   const int max_steps = static_cast<int>(std::ceil(task_.walk.max_time / m->opt.timestep)) + 1;
-  e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  if (options.push.time >= 0) {
+    PushHooks pushed(hooks, body, options.push, e);
+    e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
+  } else {
+    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  }
   e.phases = controller.phase_times();
   if (e.stats.unstable) {
     e.failed = true;

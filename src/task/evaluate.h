@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -64,6 +65,25 @@ struct EvaluationOptions {
   // exactly as without the option. The optimizer's samples use it; `diverse simulate` and
   // motion files do not.
   bool end_when_decided = false;
+  // Perturbations of the robustness suite (robust/robustness.h), never set by the
+  // optimizer, the input-motion search or a run: they are disturbances from the world
+  // that only the suite applies. A perturbed rollout cannot be recorded (its record would
+  // not replay on the saved model): asking for both is a std::logic_error.
+  //
+  // Every geom's friction coefficients (sliding, torsional, rolling) times this, on the
+  // worker's model copy for the rollout only (SimWorker::reset restores them). MuJoCo
+  // gives a contact the larger of its two geoms' coefficients, so every contact of the
+  // character with the floor or a scene object has its friction times this.
+  double friction_scale = 1.0;
+  // A push: once, at the first step whose time is at least `time` (s), the root's
+  // linear velocity changes by `dv` (m/s, world frame; a planar root takes x and z,
+  // its plane, and ignores y), then the velocity-dependent quantities of that step are
+  // recomputed (mj_fwdVelocity) before the controller sees the state. time < 0: none.
+  struct Push {
+    double time = -1;                           // s
+    std::array<double, 3> dv{0.0, 0.0, 0.0};   // m/s, world frame
+  };
+  Push push;
 };
 
 struct Evaluation {
@@ -88,6 +108,7 @@ struct Evaluation {
   // Airborne states, take-off to landing inclusive: time (s) and qpos (nq per entry).
   std::vector<double> flight_time, flight_qpos;
   std::vector<PoseSample> poses;  // 2 * samples_per_phase when the jump took off and landed
+  double push_time = -1;     // s, when EvaluationOptions::push was applied; -1 if never
   bool has_flight() const { return phases.takeoff() >= 0 && phases.peak() >= 0 && phases.landing() >= 0; }
 };
 

@@ -384,5 +384,69 @@ TEST(BadInput, MotionFilesRunDirectoriesAndCheckpoints) {
   for (const Case& c : cases) expect_user_error(c);
 }
 
+// `diverse robustness`: every option out of its range, a file that is neither a motion nor
+// a run, a motion of another task than --task. All are refused before any rollout.
+TEST(BadInput, RobustnessOptionsAndInputs) {
+  const fs::path dir = scratch("robustness");
+  const cli_test::CliResult made = cli_test::run_cli("simulate jump_high --no-film --out " + (dir / "sim").string());
+  ASSERT_EQ(made.status, 0) << made.output;
+  const std::string motion = (dir / "sim/motion.json").string();
+  const std::string rob = "robustness " + motion + " ";
+  write(dir / "notes.txt", "not json");
+  write(dir / "other.json", R"({"format": "diverse.run"})");
+  fs::create_directories(dir / "empty");
+  const Case cases[] = {
+      {rob + "--sigma 0", "--sigma: expected a number in (0, 0.5], got '0'"},
+      {rob + "--sigma 0.7", "--sigma: expected a number in (0, 0.5], got '0.7'"},
+      {rob + "--sigma nan", "--sigma: expected a number in (0, 0.5]"},
+      {rob + "--samples 0", "--samples: expected an integer in [1, 1000], got '0'"},
+      {rob + "--samples 5000", "--samples: expected an integer in [1, 1000], got '5000'"},
+      {rob + "--push -0.1", "--push: expected a number in [0, 10], got '-0.1'"},
+      {rob + "--push 11", "--push: expected a number in [0, 10], got '11'"},
+      {rob + "--seed -1", "--seed: expected"},
+      {rob + "--threads 1000", "--threads: expected an integer in [0, 256], got '1000'"},
+      {"robustness", "expected a motion file, a run directory or --task FILE"},
+      {"robustness " + (dir / "empty").string(), "empty: run.json: expected a run directory"},
+      {"robustness " + (dir / "notes.txt").string(), "notes.txt: not valid JSON"},
+      {"robustness " + (dir / "none.json").string(), "none.json: cannot read"},
+      {"robustness " + (dir / "other.json").string(), "other.json: format: expected \"diverse.motion\""},
+      {"robustness " + kTask, "jump_high.toml: not valid JSON"},
+      // A motion of the high jump against the backflip, the walk or the 3D backwards jump.
+      {rob + "--task backflip", "motion.json: task: expected a motion of task 'backflip' (--task backflip), got 'jump_high'"},
+      {rob + "--task silly_walk", "motion.json: task: expected a motion of task 'silly_walk'"},
+      {rob + "--task jump_backwards", "motion.json: task: expected a motion of task 'jump_backwards'"},
+      // A parameter file needs its task; one of another task names the parameter.
+      {"robustness " + kSource + "/tasks/jump_high.m0.json", "jump_high.m0.json: format: expected a motion file"},
+      {"robustness " + kSource + "/tasks/jump_high.m0.json --task silly_walk", "jump_high.m0.json: parameters."},
+      {rob + "--out " + (dir / "notes.txt/x.json").string(), "notes.txt"},
+  };
+  for (const Case& c : cases) expect_user_error(c);
+}
+
+// `diverse replay MOTION --task FILE` with a task of another controller or character than
+// the motion's: refused before anything is replayed (it once replayed a jump "against" a
+// walk and exited 0). The motion's own task is accepted.
+TEST(BadInput, ReplayAgainstATaskOfAnotherSkill) {
+  const fs::path dir = scratch("replay_task");
+  const cli_test::CliResult made = cli_test::run_cli("simulate jump_high --no-film --out " + (dir / "sim").string());
+  ASSERT_EQ(made.status, 0) << made.output;
+  const std::string motion = (dir / "sim/motion.json").string();
+  const Case cases[] = {
+      {"replay " + motion + " --task silly_walk",
+       "motion.json: parameters: expected the parameters of controller 'walk3d' for character 'human3d'"},
+      {"replay " + motion + " --task robot_silly_walk", "motion.json: parameters: expected the parameters of controller"},
+      {"replay " + motion + " --task jump_backwards",
+       "motion.json: parameters: expected the parameters of controller 'jump3d' for character 'human3d'"},
+      {"replay " + motion + " --task robot_jump", "motion.json: parameters: expected the parameters of controller 'jump3d'"},
+      {"replay " + motion + " --task " + kSource + "/examples/own-character/leap.toml", "motion.json: "},
+  };
+  for (const Case& c : cases) expect_user_error(c);
+  // Its own task, and another task of the same controller and character, replay as before.
+  for (const char* task : {"jump_high", "backflip"}) {
+    const cli_test::CliResult ok = cli_test::run_cli("replay " + motion + " --task " + task);
+    EXPECT_EQ(ok.status, 0) << task << ": " << ok.output;
+  }
+}
+
 }  // namespace
 }  // namespace diverse

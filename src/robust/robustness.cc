@@ -1,0 +1,306 @@
+#include "robust/robustness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+namespace diverse {
+namespace {
+
+// A window of simulated time (s) and the name of the ground phase it covers.
+struct GroundWindow {
+  double begin = 0, end = 0;
+  const char* phase = "motion";
+};
+
+// The ground phases pushes are drawn in (see the header): two for a jump, one for a walk.
+std::array<GroundWindow, 2> ground_windows(const Task& task, const Evaluation& e) {
+  const double end = std::max(e.stats.time, 0.0);
+  const GroundWindow whole{0, end, "motion"};
+  if (task.walk.enabled) {
+    const auto& steps = e.summary.walk.steps;
+    const auto settle = static_cast<std::size_t>(std::max(0, task.walk.settle_steps));
+    if (steps.size() > settle) {
+      const double begin = settle > 0 ? steps[settle - 1].time : 0.0;
+      const double last = steps.back().time;
+      if (last > begin) return {GroundWindow{begin, last, "steps"}, GroundWindow{begin, last, "steps"}};
+    }
+    return {whole, whole};
+  }
+  const double takeoff = e.phases.rise >= 0 ? e.phases.takeoff() : -1;
+  const double landing = e.phases.land >= 0 ? e.phases.landing() : -1;
+  const GroundWindow before = takeoff > 0 ? GroundWindow{0, takeoff, "takeoff"} : whole;
+  GroundWindow after = before;
+  if (landing >= 0 && landing < end) {
+    after = GroundWindow{landing, std::min(end, landing + task.simulation.settle_time), "landing"};
+  }
+  return {before, after};
+}
+
+struct Direction {
+  const char* name;
+  std::array<double, 3> axis;
+};
+constexpr Direction kDirections[4] = {
+    {"forward", {1, 0, 0}}, {"backward", {-1, 0, 0}}, {"left", {0, 1, 0}}, {"right", {0, -1, 0}}};
+
+// One perturbed rollout to run: its options and parameters, and what to report of it.
+struct Job {
+  std::size_t motion = 0;
+  PerturbedRollout rollout;
+  ParameterSet parameters;
+  EvaluationOptions options;
+};
+
+EvaluationOptions judged_options() {
+  EvaluationOptions o;
+  o.samples_per_phase = 0;        // no pose samples: only C is needed
+  o.half_timestep_check = true;   // as a run judges its samples, when the task asks for it
+  return o;
+}
+
+// The perturbed rollouts of motion `m` (see the header), in order of kind and sample.
+std::vector<Job> make_jobs(const TaskEvaluator& evaluator, const MotionUnderTest& motion, std::size_t m,
+                           const Evaluation& base, const RobustnessSuite& suite) {
+  std::vector<Job> jobs;
+  const auto index = static_cast<std::uint64_t>(motion.index);
+  const Eigen::VectorXd x = motion.parameters.normalized();
+  for (int s = 0; s < suite.parameter_samples; ++s) {
+    Rng rng(derive_seed(suite.seed, {index, static_cast<std::uint64_t>(PerturbationKind::kParameters),
+                                     static_cast<std::uint64_t>(s)}));
+    Eigen::VectorXd y(x.size());
+    for (int i = 0; i < x.size(); ++i) y[i] = mirror_unit(x[i] + suite.sigma * rng.normal());
+    Job job;
+    job.motion = m;
+    job.rollout.kind = PerturbationKind::kParameters;
+    job.rollout.sample = s;
+    job.rollout.distance = (y - x).norm();
+    job.parameters = motion.parameters;
+    job.parameters.set_normalized(y);
+    // The linear map back may land an ulp outside a range at 0 or 1: put it on the bound.
+    for (int i = 0; i < job.parameters.size(); ++i) {
+      const ParamSpec& spec = job.parameters.specs()[static_cast<std::size_t>(i)];
+      double& v = job.parameters.values()[static_cast<std::size_t>(i)];
+      v = std::clamp(v, std::min(spec.lower, spec.upper), std::max(spec.lower, spec.upper));
+    }
+    job.options = judged_options();
+    jobs.push_back(std::move(job));
+  }
+  const bool planar = evaluator.body().root == RootKind::kPlanar;
+  const int directions = planar ? 2 : 4;
+  const std::array<GroundWindow, 2> windows = ground_windows(evaluator.task(), base);
+  for (int s = 0; s < suite.push_samples; ++s) {
+    Rng rng(derive_seed(suite.seed, {index, static_cast<std::uint64_t>(PerturbationKind::kPush),
+                                     static_cast<std::uint64_t>(s)}));
+    const Direction& dir = kDirections[s % directions];
+    const GroundWindow& w = windows[static_cast<std::size_t>((s / directions) % 2)];
+    Job job;
+    job.motion = m;
+    job.rollout.kind = PerturbationKind::kPush;
+    job.rollout.sample = s;
+    job.rollout.phase = w.phase;
+    job.rollout.direction = dir.name;
+    job.parameters = motion.parameters;
+    job.options = judged_options();
+    job.options.push.time = w.begin + rng.uniform() * (w.end - w.begin);
+    for (std::size_t k = 0; k < 3; ++k) job.options.push.dv[k] = suite.push_speed * dir.axis[k];
+    job.rollout.dv = job.options.push.dv;
+    jobs.push_back(std::move(job));
+  }
+  for (std::size_t f = 0; f < suite.friction_factors.size(); ++f) {
+    Job job;
+    job.motion = m;
+    job.rollout.kind = PerturbationKind::kFriction;
+    job.rollout.sample = static_cast<int>(f);
+    job.rollout.friction = suite.friction_factors[f];
+    job.parameters = motion.parameters;
+    job.options = judged_options();
+    job.options.friction_scale = suite.friction_factors[f];
+    jobs.push_back(std::move(job));
+  }
+  if (suite.half_timestep) {
+    Job job;
+    job.motion = m;
+    job.rollout.kind = PerturbationKind::kHalfTimestep;
+    job.rollout.timestep_scale = 0.5;
+    job.parameters = motion.parameters;
+    job.options = judged_options();
+    job.options.timestep_scale = 0.5;
+    job.options.half_timestep_check = false;  // judged on its own C
+    jobs.push_back(std::move(job));
+  }
+  return jobs;
+}
+
+bool holds(const Evaluation& e) { return !e.failed && e.constraint == 0; }
+
+nlohmann::json rollout_json(const PerturbedRollout& r) {
+  nlohmann::json j = {{"constraint", r.constraint}, {"holds", r.holds}};
+  switch (r.kind) {
+    case PerturbationKind::kParameters: j["distance"] = r.distance; break;
+    case PerturbationKind::kPush:
+      j["phase"] = r.phase;
+      j["direction"] = r.direction;
+      j["time"] = r.push_time;
+      j["dv"] = r.dv;
+      break;
+    case PerturbationKind::kFriction: j["factor"] = r.friction; break;
+    case PerturbationKind::kHalfTimestep: j["timestep_scale"] = r.timestep_scale; break;
+  }
+  if (!r.fall_reason.empty()) j["fell"] = r.fall_reason;
+  if (!r.failure.empty()) j["failure"] = r.failure;
+  return j;
+}
+
+constexpr PerturbationKind kKinds[kPerturbationKinds] = {PerturbationKind::kParameters, PerturbationKind::kPush,
+                                                         PerturbationKind::kFriction, PerturbationKind::kHalfTimestep};
+
+}  // namespace
+
+const char* perturbation_key(PerturbationKind kind) {
+  switch (kind) {
+    case PerturbationKind::kParameters: return "parameters";
+    case PerturbationKind::kPush: return "pushes";
+    case PerturbationKind::kFriction: return "friction";
+    case PerturbationKind::kHalfTimestep: return "half_timestep";
+  }
+  return "?";
+}
+
+double mirror_unit(double x) {
+  if (!std::isfinite(x)) return 0.5;  // never from a finite sigma; kept inside all the same
+  // The mirror is even (x and -x map alike), so work on |x|: exact for -0.1.
+  const double t = std::fmod(std::fabs(x), 2.0);
+  return t <= 1.0 ? t : 2.0 - t;
+}
+
+int MotionRobustness::held(PerturbationKind kind) const {
+  return static_cast<int>(std::count_if(rollouts.begin(), rollouts.end(),
+                                        [kind](const PerturbedRollout& r) { return r.kind == kind && r.holds; }));
+}
+int MotionRobustness::count(PerturbationKind kind) const {
+  return static_cast<int>(std::count_if(rollouts.begin(), rollouts.end(),
+                                        [kind](const PerturbedRollout& r) { return r.kind == kind; }));
+}
+int MotionRobustness::held() const {
+  return static_cast<int>(
+      std::count_if(rollouts.begin(), rollouts.end(), [](const PerturbedRollout& r) { return r.holds; }));
+}
+int MotionRobustness::count() const { return static_cast<int>(rollouts.size()); }
+
+std::vector<MotionRobustness> run_robustness_suite(const TaskEvaluator& evaluator,
+                                                   const std::vector<MotionUnderTest>& motions,
+                                                   const RobustnessSuite& suite, ThreadPool& pool) {
+  // The unperturbed rollouts: C, and the phase times the pushes are drawn in.
+  std::vector<Evaluation> base(motions.size());
+  pool.parallel_for(motions.size(), [&](std::size_t m, int) {
+    base[m] = evaluator.evaluate_named(motions[m].parameters, judged_options());
+  });
+  std::vector<Job> jobs;
+  for (std::size_t m = 0; m < motions.size(); ++m) {
+    std::vector<Job> more = make_jobs(evaluator, motions[m], m, base[m], suite);
+    for (Job& j : more) jobs.push_back(std::move(j));
+  }
+  pool.parallel_for(jobs.size(), [&](std::size_t k, int) {
+    Job& job = jobs[k];
+    const Evaluation e = evaluator.evaluate_named(job.parameters, job.options);
+    PerturbedRollout& r = job.rollout;
+    r.constraint = e.constraint;
+    r.holds = holds(e);
+    r.failure = e.failed ? e.failure : "";
+    r.fall_reason = e.fell ? e.summary.fall_reason : "";
+    if (r.kind == PerturbationKind::kPush) r.push_time = e.push_time;
+  });
+  std::vector<MotionRobustness> results(motions.size());
+  for (std::size_t m = 0; m < motions.size(); ++m) {
+    results[m].label = motions[m].label;
+    results[m].index = motions[m].index;
+    results[m].constraint = base[m].constraint;
+  }
+  for (Job& job : jobs) results[job.motion].rollouts.push_back(std::move(job.rollout));
+  return results;
+}
+
+nlohmann::json robustness_json(const TaskEvaluator& evaluator, const RobustnessSuite& suite,
+                               const std::vector<MotionRobustness>& results) {
+  const bool planar = evaluator.body().root == RootKind::kPlanar;
+  nlohmann::json directions = nlohmann::json::array();
+  for (int k = 0; k < (planar ? 2 : 4); ++k) directions.push_back(kDirections[k].name);
+  nlohmann::json out = {
+      {"format", "diverse.robustness"},
+      {"version", 1},
+      {"task", evaluator.task().name},
+      {"strength", evaluator.task().strength},
+      {"suite",
+       {{"seed", suite.seed},
+        {"parameter_samples", suite.parameter_samples},
+        {"sigma", suite.sigma},
+        {"bounds", "mirror"},
+        {"push_samples", suite.push_samples},
+        {"push_speed", suite.push_speed},
+        {"push_directions", directions},
+        {"friction_factors", suite.friction_factors},
+        {"half_timestep", suite.half_timestep},
+        {"task_half_timestep_check", evaluator.task().constraints.half_timestep}}},
+  };
+  nlohmann::json motions = nlohmann::json::array();
+  for (const MotionRobustness& r : results) {
+    nlohmann::json kinds = nlohmann::json::object();
+    for (PerturbationKind kind : kKinds) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const PerturbedRollout& p : r.rollouts)
+        if (p.kind == kind) list.push_back(rollout_json(p));
+      kinds[perturbation_key(kind)] = {{"held", r.held(kind)}, {"count", r.count(kind)}, {"rollouts", list}};
+    }
+    motions.push_back({{"label", r.label},
+                       {"index", r.index},
+                       {"constraint", r.constraint},
+                       {"held", r.held()},
+                       {"count", r.count()},
+                       {"share", r.count() > 0 ? static_cast<double>(r.held()) / r.count() : 0.0},
+                       {"kinds", kinds}});
+  }
+  out["motions"] = motions;
+  return out;
+}
+
+nlohmann::json robustness_json(const TaskEvaluator& evaluator, const std::vector<MotionUnderTest>& motions,
+                               const RobustnessSuite& suite, ThreadPool& pool) {
+  return robustness_json(evaluator, suite, run_robustness_suite(evaluator, motions, suite, pool));
+}
+
+std::string robustness_shares(const nlohmann::json& motion, const std::string& origin) {
+  static constexpr std::pair<const char*, const char*> kShort[kPerturbationKinds] = {
+      {"parameters", "params"}, {"pushes", "pushes"}, {"friction", "friction"}, {"half_timestep", "half-step"}};
+  auto count = [&](const nlohmann::json& j, const char* key, const std::string& field) {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number_integer() || j[key].get<long long>() < 0)
+      throw_field_error(origin, field + "." + key, "expected a count (an integer >= 0)");
+    return j[key].get<long long>();
+  };
+  if (!motion.is_object() || !motion.contains("kinds") || !motion["kinds"].is_object())
+    throw_field_error(origin, "motions[].kinds", "expected the counts of every kind of perturbation");
+  std::string text;
+  long long held = 0, total = 0;
+  for (const auto& [key, name] : kShort) {
+    const std::string field = std::string("motions[].kinds.") + key;
+    if (!motion["kinds"].contains(key)) throw_field_error(origin, field, "expected the counts of this kind");
+    const nlohmann::json& k = motion["kinds"][key];
+    const long long h = count(k, "held", field), c = count(k, "count", field);
+    if (h > c) throw_field_error(origin, field + ".held", "expected at most its count");
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%s%s %lld/%lld", text.empty() ? "" : ", ", name, h, c);
+    text += buffer;
+    held += h;
+    total += c;
+  }
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, ", all %lld/%lld = %.0f %%", held, total,
+                total > 0 ? 100.0 * static_cast<double>(held) / static_cast<double>(total) : 0.0);
+  return text + buffer;
+}
+
+}  // namespace diverse
