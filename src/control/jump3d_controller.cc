@@ -85,6 +85,16 @@ std::string pose_name(int phase, const Character& body, const Layout& l, int gro
   return std::string(jump_phase_name(phase)) + "." + name;
 }
 
+// Whether a posed group's value in `phase` is two parameters, _left and _right: every
+// left/right pair when asymmetric, but for the hips in stance, whose value is the root's
+// world pitch.
+bool split(bool asymmetric, int phase, const Character& body, const Layout& l, int group) {
+  return asymmetric && body.groups[static_cast<size_t>(group)].joints.size() == 2 &&
+         !(is_stance(phase) && group == l.hip);
+}
+
+constexpr const char* kSideSuffix[2] = {"_left", "_right"};
+
 ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group) {
   const CharacterJoint& j = body.joints[static_cast<size_t>(body.groups[static_cast<size_t>(group)].joints[0])];
   double lo = j.lower, hi = j.upper;
@@ -146,13 +156,14 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_hei
 // The plug-in.
 
 std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const TomlReader& r) const {
-  r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd"});
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd", "asymmetric"});
   auto c = std::make_shared<Jump3dControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
   c->extend_timeout = r.number("extend_timeout", 0.1, 3, c->extend_timeout);
   c->com_kp = r.number("com_kp", 0, 500, c->com_kp);
   c->com_kd = r.number("com_kd", 0, 100, c->com_kd);
+  c->asymmetric = r.boolean("asymmetric", c->asymmetric);
   return c;
 }
 
@@ -183,8 +194,11 @@ void Jump3dControllerType::check(const Character& body, const std::string& task_
   }
 }
 
-std::vector<ParamSpec> Jump3dControllerType::parameter_specs(const Character& body, const ControllerConfig&) const {
-  return Jump3dController::parameter_specs(body);
+std::vector<ParamSpec> Jump3dControllerType::parameter_specs(const Character& body,
+                                                             const ControllerConfig& config) const {
+  const auto* c = dynamic_cast<const Jump3dControllerConfig*>(&config);
+  if (c == nullptr) throw std::logic_error("jump3d: configuration of another controller");
+  return Jump3dController::parameter_specs(body, c->asymmetric);
 }
 
 std::unique_ptr<Controller> Jump3dControllerType::make(const Character& body, const ControllerConfig& config,
@@ -199,12 +213,26 @@ std::unique_ptr<Controller> Jump3dControllerType::make(const Character& body, co
 // ---------------------------------------------------------------------------------------
 // The controller.
 
-std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body) {
+std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body, bool asymmetric) {
   const Layout l = layout_of(body);
   std::vector<ParamSpec> specs;
+  // One parameter, or two (NAME_left, NAME_right) with the same range.
+  auto add = [&specs](const ParamSpec& spec, bool two) {
+    if (!two) {
+      specs.push_back(spec);
+      return;
+    }
+    for (const char* suffix : kSideSuffix) {
+      ParamSpec side = spec;
+      side.name += suffix;
+      specs.push_back(side);
+    }
+  };
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
-    append_jump_gain_specs(p, specs);
+    for (int g : l.posed) add(pose_spec(p, body, l, g), split(asymmetric, p, body, l, g));
+    std::vector<ParamSpec> gains;
+    append_jump_gain_specs(p, gains);
+    for (const ParamSpec& g : gains) add(g, asymmetric);
   }
   specs.push_back({"start.duration", 0.05, 0.6, "s"});
   specs.push_back({"crouch.duration", 0.1, 1.0, "s"});
@@ -213,8 +241,8 @@ std::vector<ParamSpec> Jump3dController::parameter_specs(const Character& body) 
   specs.push_back({"extend.lean", -0.4, 0.4, "m"});
   specs.push_back({"extend.speed", -6.0, 6.0, "m/s"});
   specs.push_back({"land.balance_offset", -0.1, 0.1, "m"});
-  specs.push_back({"landing.offset", -0.4, 0.4, "m"});
-  specs.push_back({"landing.velocity_gain", -0.4, 0.4, "s"});
+  add({"landing.offset", -0.4, 0.4, "m"}, asymmetric);
+  add({"landing.velocity_gain", -0.4, 0.4, "s"}, asymmetric);
   return specs;
 }
 
@@ -233,8 +261,18 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
   gain_slot_[static_cast<size_t>(hip_)] = 0;
   gain_slot_[static_cast<size_t>(knee_)] = 1;
   gain_slot_[static_cast<size_t>(ankle_)] = 2;
-  for (auto& p : pose_) p.assign(posed_.size(), 0.0);
+  for (auto& p : pose_) p.assign(posed_.size(), Sides{0, 0});
   const size_t n = body.joints.size();
+  side_.assign(n, 0);
+  for (size_t k = 0; k < n; ++k) side_[k] = body.joints[k].side == Side::kRight ? 1 : 0;
+  for (int p = 0; p < kNumJumpPhases; ++p) {
+    for (int g : posed_) {
+      const bool two = split(config.asymmetric, p, body, l, g);
+      split_[static_cast<size_t>(p)].push_back(two ? 1 : 0);
+      param_count_ += two ? 2 : 1;
+    }
+  }
+  param_count_ += kNumJumpPhases * (config.asymmetric ? 12 : 6) + (config.asymmetric ? 11 : 9);
   target_.assign(n, 0.0);
   flight_from_.assign(n, 0.0);
   from_.joints.assign(n, 0.0);
@@ -258,14 +296,22 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
 }
 
 void Jump3dController::set_parameters(const std::vector<double>& values) {
-  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 9;
-  if (values.size() != count) throw std::logic_error("Jump3dController: parameter count");
+  if (values.size() != param_count_) throw std::logic_error("Jump3dController: parameter count");
+  const bool asymmetric = config_.asymmetric;
   size_t k = 0;
+  // In parameter_specs() order: one value for both sides, or the left's then the right's.
+  auto next = [&](bool two) {
+    Sides v;
+    v[0] = values[k++];
+    v[1] = two ? values[k++] : v[0];
+    return v;
+  };
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (size_t g = 0; g < posed_.size(); ++g) pose_[static_cast<size_t>(p)][g] = values[k++];
-    for (int j = 0; j < 3; ++j) {
-      kp_[static_cast<size_t>(p)][static_cast<size_t>(j)] = values[k++];
-      kd_[static_cast<size_t>(p)][static_cast<size_t>(j)] = values[k++];
+    const size_t ps = static_cast<size_t>(p);
+    for (size_t g = 0; g < posed_.size(); ++g) pose_[ps][g] = next(split_[ps][g] != 0);
+    for (size_t j = 0; j < 3; ++j) {
+      kp_[ps][j] = next(asymmetric);
+      kd_[ps][j] = next(asymmetric);
     }
   }
   start_duration_ = values[k++];
@@ -275,8 +321,8 @@ void Jump3dController::set_parameters(const std::vector<double>& values) {
   extend_lean_ = values[k++];
   extend_speed_ = values[k++];
   land_offset_ = values[k++];
-  landing_offset_ = values[k++];
-  landing_velocity_gain_ = values[k++];
+  landing_offset_ = next(asymmetric);
+  landing_velocity_gain_ = next(asymmetric);
 }
 
 void Jump3dController::reset(const mjModel* m, const mjData* d) {
@@ -355,7 +401,7 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
   phase_changed_ = true;
   times_.begin[static_cast<size_t>(phase)] = t;
   const size_t n = body_.joints.size();
-  const std::vector<double>& pose = pose_[static_cast<size_t>(phase)];
+  const std::vector<Sides>& pose = pose_[static_cast<size_t>(phase)];
 
   if (is_stance(phase)) {
     if (phase == kLand) stance_->reset(m, d);  // the heading and footing it landed with
@@ -366,21 +412,21 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
       const StanceController::Pitches p = stance_->measured_pitches(d);
       from_.root = p.root;
       from_.torso = p.torso;
-      from_.foot = p.foot;
+      from_.foot = {p.foot, p.foot};  // both feet from their mean
       for (size_t k = 0; k < n; ++k) from_.joints[k] = d->qpos[body_.joints[k].qpos];
     } else {
       from_ = goal_;
     }
-    goal_.root = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])];
+    goal_.root = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])][0];
     goal_.foot = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(foot_group_)])];
-    goal_.torso = chest_ >= 0 ? pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(chest_)])] : goal_.root;
+    goal_.torso = chest_ >= 0 ? pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(chest_)])][0] : goal_.root;
     for (size_t k = 0; k < n; ++k) {
       const int g = body_.joints[k].group;
       const int slot = pose_slot_[static_cast<size_t>(g)];
       if (g == hip_ || g == foot_group_ || g == chest_) {
         goal_.joints[k] = from_.joints[k];  // tracked in the world; held if the leg is off the ground
       } else {
-        goal_.joints[k] = slot >= 0 ? pose[static_cast<size_t>(slot)] : qpos0_[k];
+        goal_.joints[k] = slot >= 0 ? pose[static_cast<size_t>(slot)][static_cast<size_t>(side_[k])] : qpos0_[k];
       }
     }
     for (size_t k = 0; k < n; ++k) {
@@ -389,13 +435,18 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
       // The strength model scales every joint's PD gains (Character::strength).
       const double s = body_.strength;
       if (gs >= 0) {
-        stance_->set_joint_gains(static_cast<int>(k), s * kp_[static_cast<size_t>(phase)][static_cast<size_t>(gs)],
-                                 s * kd_[static_cast<size_t>(phase)][static_cast<size_t>(gs)]);
+        const size_t side = static_cast<size_t>(side_[k]);
+        stance_->set_joint_gains(static_cast<int>(k), s * kp_[static_cast<size_t>(phase)][static_cast<size_t>(gs)][side],
+                                 s * kd_[static_cast<size_t>(phase)][static_cast<size_t>(gs)][side]);
       } else {
         stance_->set_joint_gains(static_cast<int>(k), s * g.kp, s * g.kd);
       }
     }
-    stance_->set_root_gains(2 * kp_[static_cast<size_t>(phase)][0], 2 * kd_[static_cast<size_t>(phase)][0]);
+    // The root's gains are the two hips' (twice the hip gain when they share it; x + x is
+    // 2 x exactly).
+    const auto& hip_kp = kp_[static_cast<size_t>(phase)][0];
+    const auto& hip_kd = kd_[static_cast<size_t>(phase)][0];
+    stance_->set_root_gains(hip_kp[0] + hip_kp[1], hip_kd[0] + hip_kd[1]);
     const double h = stance_->heading();
     const double offset = phase == kLand ? land_offset_ : phase == kExtend ? extend_lean_ : lean_;
     stance_->set_com_offset(offset * std::cos(h), offset * std::sin(h));
@@ -442,7 +493,8 @@ void Jump3dController::landing_hips(const mjData* d, std::vector<double>& target
     double goal[2];
     for (int i = 0; i < 2; ++i) {
       goal[i] = com_[static_cast<size_t>(i)] + com_vel_[static_cast<size_t>(i)] * t_cross +
-                landing_offset_ * f[i] + landing_velocity_gain_ * com_vel_[static_cast<size_t>(i)] +
+                landing_offset_[static_cast<size_t>(s)] * f[i] +
+                landing_velocity_gain_[static_cast<size_t>(s)] * com_vel_[static_cast<size_t>(i)] +
                 leg.lateral * lat[i];
     }
     // The leg (hip to foot joint) with the joints between at their targets, in the root's
@@ -518,7 +570,8 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
 
   if (is_stance(phase_)) {
     stance_->set_pitches(from_.root + s * (goal_.root - from_.root), from_.torso + s * (goal_.torso - from_.torso),
-                         from_.foot + s * (goal_.foot - from_.foot));
+                         {from_.foot[0] + s * (goal_.foot[0] - from_.foot[0]),
+                          from_.foot[1] + s * (goal_.foot[1] - from_.foot[1])});
     for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
     stance_->set_targets(target_);
     stance_->control(m, d, drive);
@@ -526,10 +579,10 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   }
 
   // Flight: PD toward the phase's joint targets.
-  const std::vector<double>& pose = pose_[static_cast<size_t>(phase_)];
+  const std::vector<Sides>& pose = pose_[static_cast<size_t>(phase_)];
   for (size_t k = 0; k < n; ++k) {
     const int slot = pose_slot_[static_cast<size_t>(body_.joints[k].group)];
-    const double goal = slot >= 0 ? pose[static_cast<size_t>(slot)] : qpos0_[k];
+    const double goal = slot >= 0 ? pose[static_cast<size_t>(slot)][static_cast<size_t>(side_[k])] : qpos0_[k];
     target_[k] = flight_from_[k] + s * (goal - flight_from_[k]);
   }
   if (phase_ == kFall && config_.landing_control) {
@@ -565,8 +618,9 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
     const CharacterJoint& j = body_.joints[k];
     const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
     const int gs = gain_slot_[static_cast<size_t>(j.group)];
-    const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)] : g.kp);
-    const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)] : g.kd);
+    const size_t side = static_cast<size_t>(side_[k]);
+    const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)][side] : g.kp);
+    const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)][side] : g.kd);
     drive.set(static_cast<int>(k), p * (target_[k] - d->qpos[j.qpos]), v);
   }
 }

@@ -48,6 +48,20 @@
 // leg's geometry at the model's standing pose with the knee at its phase target, solved
 // exactly for a universal hip with orthogonal axes.
 //
+// Asymmetry (`[controller] asymmetric = true`; SPEC 12: "the 3D jumps may break left-right
+// symmetry"). By default left and right of every left/right pair share their parameters,
+// as the paper's 3D jumps do, and every motion is mirror-symmetric up to the character and
+// the simulation. With the option, every parameter of a pair is two, PARAM_left and
+// PARAM_right with the shared parameter's range (e.g. "rise.knee_left", "crouch.foot_right"
+// for the feet's world pitch in stance, "fall.kp_hip_left", "landing.offset_right"): the
+// joint targets of each pair in every phase, the feet's world pitches in stance, the phase
+// gains of the hips, knees and ankles, and the landing controller's offset and velocity
+// gain of each foot. What the body has one of stays one: the root's and the torso's world
+// pitches in stance (their gains, twice the hips', become the sum of the two hips'), the
+// waist, the durations, the leans, the push-off speed and the landing balance offset. Each
+// side given the shared parameter's value gives the symmetric controller's rollout bit for
+// bit (a stance phase's feet start from their mean measured pitch either way).
+//
 // No external force is ever applied: the root is unactuated and every torque goes through
 // the joint drive (physics/drive.h), which keeps it within the joint's limit on the net
 // torque.
@@ -90,6 +104,7 @@ struct Jump3dControllerConfig : ControllerConfig {
   double extend_timeout = 0.8;   // s; an extend that never leaves the ground ends here
   double airborne_time = 0.01;   // s without contact (COM rising) that counts as take-off
   double com_kp = 40, com_kd = 12;  // 1/s^2, 1/s: the stance phases' horizontal COM servo
+  bool asymmetric = false;       // left and right of every pair have their own parameters
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -116,8 +131,9 @@ class Jump3dController : public Controller {
   // The free parameters for `body`: per phase a value per parameterized group and kp, kd
   // of hips, knees and ankles; then the durations, the leans of crouch and extend, the
   // push-off speed, the landing balance offset and the landing controller's offset and
-  // velocity gain (81 for the 3D human, 69 for the bird robot).
-  static std::vector<ParamSpec> parameter_specs(const Character& body);
+  // velocity gain (81 for the 3D human, 69 for the bird robot). `asymmetric`: every
+  // parameter of a left/right pair split in two, _left and _right (145 and 127).
+  static std::vector<ParamSpec> parameter_specs(const Character& body, bool asymmetric = false);
   void set_parameters(const std::vector<double>& values);
 
   void reset(const mjModel* m, const mjData* d) override;
@@ -135,7 +151,8 @@ class Jump3dController : public Controller {
   // What a stance phase interpolates: the three world pitches, then one joint target per
   // Character::joints entry.
   struct StanceTargets {
-    double root = 0, torso = 0, foot = 0;
+    double root = 0, torso = 0;
+    std::array<double, 2> foot{0, 0};  // left, right
     std::vector<double> joints;
   };
   // A leg at the model's qpos0, in the root's frame: the hip, then the joints between the
@@ -161,12 +178,17 @@ class Jump3dController : public Controller {
   std::vector<int> posed_;       // parameterized groups, in parameter order
   std::vector<int> pose_slot_;   // per group: index into posed_, or -1
   std::vector<int> gain_slot_;   // per group: 0 hip, 1 knee, 2 ankle, -1 default gains
+  std::vector<int> side_;        // per joint: 0 left (or centre), 1 right
+  size_t param_count_ = 0;       // parameter_specs(body, config.asymmetric).size()
+  std::array<std::vector<char>, kNumJumpPhases> split_{};  // per phase, per posed_: _left and _right
 
-  // Parameters unpacked.
-  std::array<std::vector<double>, kNumJumpPhases> pose_{};
-  std::array<std::array<double, 3>, kNumJumpPhases> kp_{}, kd_{};
+  // Parameters unpacked, per side (left, right; the same twice where they are shared).
+  using Sides = std::array<double, 2>;
+  std::array<std::vector<Sides>, kNumJumpPhases> pose_{};  // per posed_ entry
+  std::array<std::array<Sides, 3>, kNumJumpPhases> kp_{}, kd_{};
   double start_duration_ = 0.2, crouch_duration_ = 0.4, land_duration_ = 0.3;
-  double lean_ = 0, extend_lean_ = 0, extend_speed_ = 0, land_offset_ = 0, landing_offset_ = 0, landing_velocity_gain_ = 0;
+  double lean_ = 0, extend_lean_ = 0, extend_speed_ = 0, land_offset_ = 0;
+  Sides landing_offset_{0, 0}, landing_velocity_gain_{0, 0};
 
   // Set at reset() from the model.
   std::unique_ptr<StanceController> stance_;

@@ -71,8 +71,20 @@ void ParameterSet::set_from_json(const nlohmann::json& object, const std::string
     throw_field_error(origin, "parameters", "expected an object mapping parameter names to numbers");
   }
   for (const auto& [name, value] : object.items()) {
-    if (find(name) < 0) throw_field_error(origin, "parameters." + name, "expected a known parameter name (unknown parameter)");
     (void)value;
+    if (find(name) >= 0) continue;
+    // A parameter that this controller splits in two (jump3d's `asymmetric`: NAME_left and
+    // NAME_right) is named so that a file written for the shared one says what to do.
+    std::string split;
+    for (const ParamSpec& s : specs_) {
+      if (s.name.size() > name.size() && s.name.compare(0, name.size() + 1, name + "_") == 0) {
+        split += (split.empty() ? "" : ", ") + s.name;
+      }
+    }
+    throw_field_error(origin, "parameters." + name,
+                      split.empty() ? "expected a known parameter name (unknown parameter)"
+                                    : "expected a known parameter name (unknown parameter; this controller has " +
+                                          split + " instead)");
   }
   for (int i = 0; i < size(); ++i) {
     const ParamSpec& s = specs_[i];

@@ -45,7 +45,8 @@ class ParameterSet {
   // {"name": value, ...} with every parameter.
   nlohmann::json to_json() const;
   // Strict: every parameter present, no unknown names, finite numbers inside their
-  // ranges. Errors are UserError "ORIGIN: parameters.NAME: expected ...".
+  // ranges. Errors are UserError "ORIGIN: parameters.NAME: expected ..."; an unknown NAME
+  // whose NAME_* parameters exist (a left/right pair split in two) names them..
   void set_from_json(const nlohmann::json& object, const std::string& origin);
 
  private:

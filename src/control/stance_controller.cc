@@ -367,10 +367,10 @@ bool StanceController::foot_contact(const mjData* d, int side) const {
   return false;
 }
 
-void StanceController::set_pitches(double root, double torso, double foot) {
+void StanceController::set_pitches(double root, double torso, const std::array<double, 2>& feet) {
   pitch_root_ = root;
   pitch_torso_ = torso;
-  pitch_foot_ = foot;
+  pitch_foot_ = feet;
   update_targets();
 }
 
@@ -448,10 +448,12 @@ void StanceController::update_targets() {
   mju_mulQuat(torso, standing, torso_in_root_.data());
   pitched(pitch_torso_, torso, torso_target_.data());
   const double identity[4] = {1, 0, 0, 0};
-  double foot[4];
-  pitched(pitch_foot_, identity, foot);
   const double z[3] = {0, 0, 1};
-  mju_rotVecQuat(foot_up_target_.data(), z, foot);
+  for (size_t s = 0; s < 2; ++s) {
+    double foot[4];
+    pitched(pitch_foot_[s], identity, foot);
+    mju_rotVecQuat(foot_up_target_[s].data(), z, foot);
+  }
 }
 
 void StanceController::control(const mjModel* m, const mjData* d, JointDrive& drive) {
@@ -574,7 +576,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     const double* up0 = foot_up_[static_cast<size_t>(s)].data();
     double up[3];
     mju_mulMatVec(up, R, up0, 3, 3);
-    const double* z = foot_up_target_.data();
+    const double* z = foot_up_target_[static_cast<size_t>(s)].data();
     double e[3];
     mju_cross(e, up, z);
     const double sin_angle = mju_norm3(e);

@@ -108,7 +108,9 @@ class StanceController {
   // about the lateral axis of the heading taken at reset() (positive backwards, as the
   // joints about -y turn): the root's target becomes pitch(root) * heading * standing, and
   // likewise the torso's target and the feet's "up". All 0 (the default) is standing.
-  void set_pitches(double root, double torso, double foot);
+  // The second form gives each foot its own pitch (left, right).
+  void set_pitches(double root, double torso, double foot) { set_pitches(root, torso, {foot, foot}); }
+  void set_pitches(double root, double torso, const std::array<double, 2>& feet);
   // PD gains of joint k (its group's by default). For a foot joint they are the gains of
   // the foot's world tracking, for the tracked waist those of the torso's; a stance hip
   // takes none (the root's gains act through it).
@@ -172,7 +174,8 @@ class StanceController {
   std::array<double, 2> offset_{0, 0};
   std::array<double, 2> velocity_{0, 0};
   ComForce com_force_ = ComForce::kBalance;
-  double pitch_root_ = 0, pitch_torso_ = 0, pitch_foot_ = 0;
+  double pitch_root_ = 0, pitch_torso_ = 0;
+  std::array<double, 2> pitch_foot_{0, 0};  // rad, left and right
   std::vector<double> kp_, kd_gain_;  // per joint: PD gains
 
   // Structure, found once.
@@ -195,7 +198,7 @@ class StanceController {
   std::array<double, 4> heading_quat_{1, 0, 0, 0};  // yaw of the heading relative to standing
   std::array<double, 4> root_target_{1, 0, 0, 0};
   std::array<double, 4> torso_target_{1, 0, 0, 0};
-  std::array<double, 3> foot_up_target_{0, 0, 1};
+  std::array<std::array<double, 3>, 2> foot_up_target_{{{0, 0, 1}, {0, 0, 1}}};  // left, right
   double height_target_ = 0;
 
   // Per step.

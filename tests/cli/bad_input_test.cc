@@ -191,6 +191,11 @@ TEST(BadInput, TaskFileFields) {
       task_case(task_text("jump_high", {{"above_standing = 0.293", "above_standing = nan"}}),
                 "constraints.peak_height.above_standing: expected a number in [0, 5], got nan"),
       task_case(task_text("jump_high", {{"type = \"jump2d\"", "type = \"jump9d\""}}), "controller.type"),
+      // jump3d's asymmetric option takes true or false only.
+      task_case(task_text("jump_backwards", {{"asymmetric = true", "asymmetric = \"yes\""}}),
+                "controller.asymmetric: expected true or false"),
+      task_case(task_text("jump_backwards", {{"asymmetric = true", "asymmetric = 1"}}),
+                "controller.asymmetric: expected true or false"),
       task_case(task_text("jump_high", {{"character = \"" + kSource + "/assets/characters/human2d.toml\"",
                                          "character = \"" + dir.string() + "\""}}),
                 "character: expected an existing file (relative to the task file)"),

@@ -44,5 +44,26 @@ TEST(ParameterSet, OutOfRangeValueIsAOneLineError) {
   }
 }
 
+// An unknown name is refused; when the set has NAME_left and NAME_right instead (a pair the
+// controller splits, jump3d's `asymmetric`), the one line says so.
+TEST(ParameterSet, UnknownNameNamesTheParametersThatSplitIt) {
+  ParameterSet p({{"rise.knee_left", -2.6, 0.0, "rad"}, {"rise.knee_right", -2.6, 0.0, "rad"}, {"rise.waist", -1, 1, "rad"}},
+                 {0.0, 0.0, 0.0});
+  auto error = [&](const nlohmann::json& j) {
+    try {
+      p.set_from_json(j, "m0.json");
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error({{"rise.knee", -1.0}, {"rise.waist", 0.0}}),
+            "m0.json: parameters.rise.knee: expected a known parameter name (unknown parameter; this controller has "
+            "rise.knee_left, rise.knee_right instead)");
+  EXPECT_EQ(error({{"rise.kne", -1.0}}), "m0.json: parameters.rise.kne: expected a known parameter name (unknown parameter)");
+  EXPECT_EQ(error({{"rise.knee_left", -1.0}, {"rise.waist", 0.0}}),
+            "m0.json: parameters.rise.knee_right: expected a number in [-2.6, 0] rad");
+}
+
 }  // namespace
 }  // namespace diverse
