@@ -138,7 +138,6 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
   EvaluationOptions fine_options;
   fine_options.samples_per_phase = 0;
   fine_options.timestep_scale = 0.5;
-  fine_options.end_when_decided = true;
   MotionOutcome scratch;
   const Evaluation fine = run(x, worker, fine_options, scratch);
   MotionSummary landed;
@@ -225,9 +224,7 @@ void MotionProblem::apply_bounds(MotionOutcome& outcome) const {
 std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::VectorXd& x,
                                                                int worker) const {
   auto outcome = std::make_shared<MotionOutcome>();
-  EvaluationOptions options;
-  options.end_when_decided = true;
-  const Evaluation e = run(x, worker, options, *outcome);
+  const Evaluation e = run(x, worker, EvaluationOptions{}, *outcome);
   outcome->constraint = e.constraint;
   outcome->task_constraint = e.constraint;
   outcome->effort = e.stats.effort;

@@ -9,6 +9,7 @@
 #include "io/motion_record.h"
 #include "physics/model.h"
 #include "render/run_media.h"
+#include "robust/robustness.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
@@ -205,6 +206,23 @@ void write_run_outputs(const RunOutputs& o) {
   if (objective.combined()) summary["shape_weight"] = objective.shape_weight;
   if (!o.messages.is_null()) summary["timing"]["messages"] = o.messages;
   if (!o.rollouts.is_null()) summary["timing"]["rollouts"] = o.rollouts;
+
+  // The robustness suite (robust/robustness.h) on every motion: robustness.json in full,
+  // and each motion's shares, by kind and over all, in the summary.
+  std::vector<MotionUnderTest> under_test;
+  for (std::size_t i = 0; i < count; ++i)
+    under_test.push_back({label(i), static_cast<int>(i), o.problem.named(result.parameters[i])});
+  const nlohmann::json suite = robustness_json(o.evaluator, under_test, RobustnessSuite{}, o.pool);
+  write_json_atomic(o.dir / "robustness.json", suite);
+  nlohmann::json shares = nlohmann::json::array();
+  for (const nlohmann::json& m : suite.at("motions")) {
+    nlohmann::json kinds = nlohmann::json::object();
+    for (const auto& [key, kind] : m.at("kinds").items())
+      kinds[key] = {{"held", kind.at("held")}, {"count", kind.at("count")}};
+    shares.push_back({{"label", m.at("label")}, {"held", m.at("held")}, {"count", m.at("count")},
+                      {"share", m.at("share")}, {"kinds", kinds}});
+  }
+  summary["robustness"] = {{"suite", suite.at("suite")}, {"motions", shares}};
   write_json_atomic(o.dir / "summary.json", summary);
 
   // The film strip is drawn from the files just written, as `diverse render` draws it.

@@ -32,7 +32,9 @@ struct RunOutputs {
 // the parameter groups, "strength", "bounds"; "samples" the optimizer's samples and
 // "feasible_samples" how many of them met their constraints; "confirmations" the
 // half-timestep checks the optimizer ran, "steps" the simulation steps by kind and outcome,
-// eval/motion_problem.h, steps_of()), per motion its C (the
+// eval/motion_problem.h, steps_of(); "robustness" each motion's shares of the robustness
+// suite, by kind and over all, whose every rollout is in robustness.json,
+// robust/robustness.h), per motion its C (the
 // task's constraints and the bounds'; "task_constraint" the task's alone), dmin, effort
 // (N^2 m^2 s), "effort_ratio" to M0's, "positive_work" (J), "distance_to_m0" in the
 // objective's distance, "within_bounds", shape scales and link lengths (m,

@@ -62,8 +62,10 @@ struct EvaluationOptions {
   // Evaluation::steps_after_decided; MotionSummary::ended_decided): its C is then what was
   // known at that moment, every term the rest could only make worse (touchdown_bound()),
   // without a later fall. A motion that meets the task is never ended, so it is simulated
-  // exactly as without the option. The optimizer's samples use it; `diverse simulate` and
-  // motion files do not.
+  // exactly as without the option. The optimizer does not use it: that C orders the
+  // samples that miss the task differently from the full rollout's (about half of their
+  // pairs), and the default job's result got worse with it (docs/results.md, "Where a
+  // run's steps go").
   bool end_when_decided = false;
   // Perturbations of the robustness suite (robust/robustness.h), never set by the
   // optimizer, the input-motion search or a run: they are disturbances from the world

@@ -73,6 +73,40 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
   EXPECT_TRUE(sa["all_satisfied"].get<bool>());
   for (int i = 0; i <= 2; ++i) EXPECT_EQ(sa["motions"][i]["constraint"], 0.0) << i;
   for (int i = 1; i <= 2; ++i) EXPECT_GT(sa["distances"]["md"][0][i].get<double>(), 0.0) << i;
+
+  // Every returned motion holds at half the timestep, though the optimizer checked only
+  // the samples a variation moved to: fewer checks than samples that met the task at the
+  // task's timestep.
+  for (int i = 0; i <= 2; ++i) EXPECT_TRUE(sa["motions"][i]["half_timestep"]["holds"].get<bool>()) << i;
+  const auto& steps = sa["steps"];
+  const long long met = steps["rollouts"]["met"]["rollouts"].get<long long>();
+  long long checks = 0, check_steps = 0, rollout_steps = 0;
+  for (const auto& [result, entry] : steps["half_timestep"].items()) {
+    checks += entry["rollouts"].get<long long>();
+    check_steps += entry["steps"].get<long long>();
+  }
+  long long rollouts = 0;
+  for (const auto& [result, entry] : steps["rollouts"].items()) {
+    rollouts += entry["rollouts"].get<long long>();
+    rollout_steps += entry["steps"].get<long long>();
+  }
+  EXPECT_EQ(rollouts, sa["evaluations"].get<long long>());
+  EXPECT_EQ(checks, sa["confirmations"].get<long long>());
+  EXPECT_GT(checks, 0);
+  EXPECT_LT(checks, met);
+  EXPECT_EQ(steps["total"].get<long long>(), rollout_steps + check_steps);
+  EXPECT_GE(steps["after_decided"].get<long long>(), 0);
+  EXPECT_LT(steps["after_decided"].get<long long>(), rollout_steps);
+  // The robustness suite's shares of every motion, by kind (robust/robustness.h), with
+  // its every rollout in robustness.json.
+  ASSERT_EQ(sa["robustness"]["motions"].size(), 3u);
+  for (const auto& m : sa["robustness"]["motions"]) {
+    EXPECT_EQ(m["count"], 19);
+    EXPECT_LE(m["held"].get<int>(), 19);
+    EXPECT_EQ(m["kinds"]["parameters"]["count"], 8);
+    EXPECT_EQ(m["kinds"]["half_timestep"]["count"], 1);
+  }
+  EXPECT_EQ(read_json(one / "robustness.json")["motions"].size(), 3u);
 }
 
 // summary.json's timing.rollouts: every rollout of the run (M0 once, then N x lambda per
