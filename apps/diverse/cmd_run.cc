@@ -59,6 +59,7 @@ struct RunArgs {
   double checkpoint_seconds = 5.0;
   double strength = 1.0;
   double effort_bound = 0.0;  // 0 = none
+  bool robust = false;
   double max_distance = 0.0;  // 0 = none
   double rank_timeout = kDefaultRankTimeoutSeconds;
 };
@@ -132,6 +133,10 @@ void install_run(CLI::App& app) {
                   "Keep every variation within X of the input motion in the run's metric, X > 0 "
                   "(default: no bound)")
       ->check(number_in(0, kMaxDistanceBound, Bound::kOpen));
+  cmd->add_flag("--robust", args->robust,
+                "A sample meets the task only if it also holds under a small seeded part of the "
+                "robustness suite (2 parameter perturbations, 2 pushes in the landing), judged "
+                "where a variation would move to it (docs/robustness.md)");
   cmd->add_option("--out", args->out, "Run directory (default: runs/<task>)");
   cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
   cmd->add_flag("--quiet", args->quiet, "No progress output");
@@ -172,6 +177,7 @@ void install_run(CLI::App& app) {
     request.strength = a.strength;
     request.bounds.effort = a.effort_bound;
     request.bounds.distance = a.max_distance;
+    request.bounds.robust = a.robust;
     std::string task_name = a.task;
     if (const auto slash = task_name.find_last_of('/'); slash != std::string::npos)
       task_name = task_name.substr(slash + 1);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "robust/robustness.h"
 
 namespace diverse {
 
@@ -31,6 +32,7 @@ nlohmann::json to_json(const MotionBounds& bounds) {
   nlohmann::json j = nlohmann::json::object();
   if (bounds.effort > 0) j["effort"] = bounds.effort;
   if (bounds.distance > 0) j["distance"] = bounds.distance;
+  if (bounds.robust) j["robust"] = true;
   return j;
 }
 
@@ -39,8 +41,8 @@ MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string&
   if (j.is_null()) return bounds;
   if (!j.is_object()) throw_field_error(where, "bounds", "expected an object");
   for (const auto& item : j.items())
-    if (item.key() != "effort" && item.key() != "distance")
-      throw_field_error(where, "bounds." + item.key(), "expected only the keys effort and distance");
+    if (item.key() != "effort" && item.key() != "distance" && item.key() != "robust")
+      throw_field_error(where, "bounds." + item.key(), "expected only the keys effort, distance and robust");
   auto number = [&](const char* key, bool open_low, double lo, double hi, const char* range) {
     if (!j.contains(key)) return 0.0;
     const nlohmann::json& v = j.at(key);
@@ -51,6 +53,10 @@ MotionBounds motion_bounds_from_json(const nlohmann::json& j, const std::string&
   };
   bounds.effort = number("effort", false, kMinEffortBound, kMaxEffortBound, "[1, 1e6]");
   bounds.distance = number("distance", true, 0, kMaxDistanceBound, "(0, 1e12]");
+  if (j.contains("robust")) {
+    if (!j.at("robust").is_boolean()) throw_field_error(where, "bounds.robust", "expected true or false");
+    bounds.robust = j.at("robust").get<bool>();
+  }
   return bounds;
 }
 
@@ -123,8 +129,8 @@ ParameterSet MotionProblem::named(const Eigen::VectorXd& x) const {
 std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
                                                       int worker) const {
   auto outcome = simulate_outcome(x, worker);
-  outcome->provisional = evaluator_->task().constraints.half_timestep && !outcome->failed &&
-                         outcome->task_constraint == 0;
+  outcome->provisional = (evaluator_->task().constraints.half_timestep || bounds_.robust) &&
+                         !outcome->failed && outcome->task_constraint == 0;
   if (bounds_.any()) apply_bounds(*outcome);
   return outcome;
 }
@@ -135,6 +141,24 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
   if (!coarse.provisional) throw std::logic_error("MotionProblem::confirm: the outcome is not provisional");
   auto confirmed = std::make_shared<MotionOutcome>(coarse);
   confirmed->provisional = false;
+  if (evaluator_->task().constraints.half_timestep) confirm_half_timestep(x, worker, *confirmed);
+  if (bounds_.robust && confirmed->task_constraint == 0 && !confirmed->failed) {
+    const SuiteVerdict verdict = check_suite(*evaluator_, named(x), robust_sample_suite());
+    confirmed->robust_steps = verdict.steps;
+    confirmed->robust_held = verdict.holds;
+    if (!verdict.holds) {
+      const double penalty = evaluator_->task().constraints.weight * 0.1 * 0.1;
+      confirmed->task_constraint += penalty;
+      confirmed->constraint = confirmed->task_constraint;
+      if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(*confirmed);
+    }
+  }
+  return confirmed;
+}
+
+void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, MotionOutcome& out) const {
+  const MotionOutcome coarse = out;
+  MotionOutcome* confirmed = &out;
   EvaluationOptions fine_options;
   fine_options.samples_per_phase = 0;
   fine_options.timestep_scale = 0.5;
@@ -153,9 +177,8 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
   confirmed->task_constraint = coarse.task_constraint + penalty;
   confirmed->constraint = confirmed->task_constraint;
   confirmed->failed = !std::isfinite(confirmed->constraint);
-  if (bounds_.any()) apply_bounds(*confirmed);
+  if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(*confirmed);
   confirmed->check_steps = fine.stats.steps;
-  return confirmed;
 }
 
 std::shared_ptr<const Outcome> MotionProblem::evaluate_confirmed(const Eigen::VectorXd& x,
@@ -183,8 +206,12 @@ void add_steps(nlohmann::json& ledger, const char* kind, const char* outcome, lo
 
 void MotionProblem::tally(const Outcome& outcome, nlohmann::json& ledger) const {
   const auto& m = dynamic_cast<const MotionOutcome&>(outcome);
-  if (m.check_steps >= 0) {  // a confirmation: only its check is new
-    add_steps(ledger, "half_timestep", m.constraint > 0 ? "failed" : "held", m.check_steps);
+  if (m.check_steps >= 0 || m.robust_steps >= 0) {  // a confirmation: only its checks are new
+    if (m.check_steps >= 0) {
+      const bool held = m.robust_steps >= 0 || m.constraint == 0;  // robustness is checked after
+      add_steps(ledger, "half_timestep", held ? "held" : "failed", m.check_steps);
+    }
+    if (m.robust_steps >= 0) add_steps(ledger, "robustness", m.robust_held ? "held" : "failed", m.robust_steps);
     return;
   }
   const char* result = m.fell || m.failed ? "fell" : m.task_constraint > 0 ? "failed" : "met";
@@ -382,6 +409,8 @@ std::string MotionProblem::encode(const Outcome& outcome) {
   w.put(m.steps);
   w.put(m.steps_after_decided);
   w.put(m.check_steps);
+  w.put(m.robust_steps);
+  w.put(static_cast<std::uint8_t>(m.robust_held));
   w.put_doubles(m.scales.data(), m.scales.size());
   w.put_doubles(m.features.link_lengths.data(), m.features.link_lengths.size());
   w.put(static_cast<std::uint64_t>(m.features.poses.size()));
@@ -419,6 +448,8 @@ std::shared_ptr<const Outcome> MotionProblem::decode(const std::string& bytes) {
   m->steps = r.get<long long>();
   m->steps_after_decided = r.get<long long>();
   m->check_steps = r.get<long long>();
+  m->robust_steps = r.get<long long>();
+  m->robust_held = r.get<std::uint8_t>() != 0;
   m->scales = r.vector();
   m->features.link_lengths = r.vector();
   const auto poses = r.get<std::uint64_t>();

@@ -53,7 +53,12 @@ namespace diverse {
 struct MotionBounds {
   double effort = 0;    // R >= 1: effort(M) <= R effort(M0)
   double distance = 0;  // X > 0: d(M, M0) <= X in the problem's distance
-  bool any() const { return effort > 0 || distance > 0; }
+  // `diverse run --robust`: a sample meets the task only if it also holds under the
+  // robustness suite's small part (robust/robustness.h, robust_sample_suite()), judged
+  // where a variation would move to it (confirm()); one that does not gets the term
+  // "robust", K_c (0.1)^2, as a landing 10 cm out would.
+  bool robust = false;
+  bool any() const { return effort > 0 || distance > 0 || robust; }
 };
 // Ranges of the bounds (`--effort-bound`, `--max-distance`).
 constexpr double kMinEffortBound = 1.0, kMaxEffortBound = 1e6;
@@ -99,8 +104,10 @@ struct MotionOutcome : Outcome {
   } landing;
   // What it cost (MotionProblem::tally): simulation steps of its rollout, of them those
   // after its outcome was decided (Evaluation::steps_after_decided), and of the
-  // half-timestep check once confirmed (-1: no check ran).
-  long long steps = 0, steps_after_decided = 0, check_steps = -1;
+  // half-timestep check once confirmed (-1: no check ran), and of the robustness check of
+  // a `--robust` run (-1: none ran; robust_held its verdict).
+  long long steps = 0, steps_after_decided = 0, check_steps = -1, robust_steps = -1;
+  bool robust_held = false;
 };
 
 class MotionProblem : public DiversityProblem {
@@ -181,6 +188,8 @@ class MotionProblem : public DiversityProblem {
                  MotionOutcome& outcome) const;
   // Adds the bounds' terms to an outcome's constraint.
   void apply_bounds(MotionOutcome& outcome) const;
+  // The half-timestep check of confirm(), on `outcome` (a copy of the provisional one).
+  void confirm_half_timestep(const Eigen::VectorXd& x, int worker, MotionOutcome& outcome) const;
 
   const TaskEvaluator* evaluator_;
   DistanceSpec distance_;

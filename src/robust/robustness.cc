@@ -97,7 +97,7 @@ std::vector<Job> make_jobs(const TaskEvaluator& evaluator, const MotionUnderTest
     Rng rng(derive_seed(suite.seed, {index, static_cast<std::uint64_t>(PerturbationKind::kPush),
                                      static_cast<std::uint64_t>(s)}));
     const Direction& dir = kDirections[s % directions];
-    const GroundWindow& w = windows[static_cast<std::size_t>((s / directions) % 2)];
+    const GroundWindow& w = windows[static_cast<std::size_t>((s / directions + suite.first_push_phase) % 2)];
     Job job;
     job.motion = m;
     job.rollout.kind = PerturbationKind::kPush;
@@ -191,6 +191,36 @@ int MotionRobustness::held() const {
       std::count_if(rollouts.begin(), rollouts.end(), [](const PerturbedRollout& r) { return r.holds; }));
 }
 int MotionRobustness::count() const { return static_cast<int>(rollouts.size()); }
+
+RobustnessSuite robust_sample_suite() {
+  RobustnessSuite suite;
+  suite.parameter_samples = 2;
+  suite.push_samples = 2;
+  suite.first_push_phase = 1;
+  suite.friction_factors.clear();
+  suite.half_timestep = false;
+  return suite;
+}
+
+SuiteVerdict check_suite(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                         const RobustnessSuite& suite) {
+  SuiteVerdict verdict;
+  EvaluationOptions plain;
+  plain.samples_per_phase = 0;
+  const Evaluation base = evaluator.evaluate_named(parameters, plain);
+  verdict.steps += base.stats.steps;
+  const MotionUnderTest motion{"sample", 0, parameters};
+  for (const Job& job : make_jobs(evaluator, motion, 0, base, suite)) {
+    const Evaluation e = evaluator.evaluate_named(job.parameters, job.options);
+    ++verdict.rollouts;
+    verdict.steps += e.stats.steps + e.check_steps;
+    if (!holds(e)) {
+      verdict.holds = false;
+      break;
+    }
+  }
+  return verdict;
+}
 
 std::vector<MotionRobustness> run_robustness_suite(const TaskEvaluator& evaluator,
                                                    const std::vector<MotionUnderTest>& motions,

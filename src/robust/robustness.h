@@ -74,7 +74,29 @@ struct RobustnessSuite {
   double push_speed = 0.3;     // m/s, the change of the root's linear velocity (every character)
   std::vector<double> friction_factors{0.6, 1.5};  // one rollout each
   bool half_timestep = true;   // one rollout at half the timestep
+  // Which ground phase the first round of pushes falls in (0: a jump's take-off phase, 1:
+  // its landing); the rounds alternate from there.
+  int first_push_phase = 0;
 };
+
+// The small part of the suite a `--robust` run asks of a sample before a variation may
+// stand at it (eval/motion_problem.h, MotionBounds::robust): 2 parameter perturbations at
+// sigma 0.02, and 2 pushes of 0.3 m/s in the landing (forward and backward; a walk's: in
+// its evaluated steps); the half-timestep check is the run's own. The same seeded draws
+// for every sample.
+RobustnessSuite robust_sample_suite();
+
+// Whether one motion holds under every rollout of `suite`, run one after another on the
+// calling thread (each on a worker of its own) until the first that fails. `steps`
+// counts every rollout's simulation steps, the unperturbed one that gives the push
+// moments and the half-timestep checks included.
+struct SuiteVerdict {
+  bool holds = true;
+  int rollouts = 0;      // perturbed rollouts run
+  long long steps = 0;
+};
+SuiteVerdict check_suite(const TaskEvaluator& evaluator, const ParameterSet& parameters,
+                         const RobustnessSuite& suite);
 
 // Ranges of the suite's settings (the command's options, and robustness.json when read).
 constexpr int kMaxRobustnessSamples = 1000;   // parameter_samples, push_samples: [1, this]

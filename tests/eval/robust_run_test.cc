@@ -1,0 +1,87 @@
+// `diverse run --robust` (eval/motion_problem.h, MotionBounds::robust): a sample meets the
+// task only if it also holds under the robustness suite's small part, judged when a
+// variation would move to it; every variation a run returns as meeting the task holds
+// under that part; the setting round-trips through run.json and bad values are refused.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/error.h"
+#include "core/thread_pool.h"
+#include "eval/motion_problem.h"
+#include "optimize/diversity.h"
+#include "robust/robustness.h"
+#include "task/task.h"
+
+namespace diverse {
+namespace {
+
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
+
+TEST(RobustRun, ConfirmationJudgesTheSuitesPart) {
+  const Task task = load_task(kTasks + "jump_forward.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  MotionBounds bounds;
+  bounds.robust = true;
+  const MotionProblem problem(ev, DistanceSpec{Metric::kMassDistance, 0.0}, m0.normalized(), 1, false, bounds);
+  const auto coarse = problem.evaluate(m0.normalized(), 0);
+  ASSERT_TRUE(coarse->provisional);
+  const auto confirmed = problem.confirm(m0.normalized(), *coarse, 0);
+  const auto& m = static_cast<const MotionOutcome&>(*confirmed);
+  ASSERT_GE(m.robust_steps, 0);
+  const SuiteVerdict verdict = check_suite(ev, m0, robust_sample_suite());
+  EXPECT_EQ(m.robust_held, verdict.holds);
+  EXPECT_EQ(m.robust_steps, verdict.steps);
+  EXPECT_EQ(m.constraint == 0.0, verdict.holds);
+  // The same motion without --robust: only the half-timestep check.
+  const MotionProblem plain(ev, Metric::kMassDistance, m0.normalized(), 1);
+  const auto& p = static_cast<const MotionOutcome&>(*plain.evaluate_confirmed(m0.normalized(), 0));
+  EXPECT_EQ(p.robust_steps, -1);
+  EXPECT_EQ(p.constraint, 0.0);
+}
+
+TEST(RobustRun, ReturnsOnlyVariationsThatHold) {
+  const Task task = load_task(kTasks + "jump_forward.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  MotionBounds bounds;
+  bounds.robust = true;
+  ThreadPool pool(2);
+  const MotionProblem problem(ev, DistanceSpec{Metric::kMassDistance, 0.0}, m0.normalized(), pool.size(), false, bounds);
+  DiversityOptions o;
+  o.variations = 2;
+  o.popsize = 8;
+  o.sigma0 = 0.02;
+  o.max_generations = 4;
+  o.seed = 2;
+  DiversityOptimizer opt(problem, o, pool);
+  opt.run();
+  EXPECT_GT(opt.confirmations(), 0);
+  EXPECT_TRUE(opt.ledger().contains("robustness"));
+  const DiversityResult r = opt.result();
+  // Every variation that meets the task holds under the suite's part.
+  for (std::size_t i = 1; i < r.parameters.size(); ++i) {
+    const bool holds = check_suite(ev, problem.named(r.parameters[i]), robust_sample_suite()).holds;
+    if (r.outcomes[i]->constraint == 0.0) {
+      EXPECT_TRUE(holds) << "M" << i;
+    }
+  }
+}
+
+TEST(RobustRun, SettingRoundTripsAndBadValuesAreRefused) {
+  MotionBounds b;
+  b.robust = true;
+  EXPECT_EQ(to_json(b), nlohmann::json({{"robust", true}}));
+  EXPECT_TRUE(motion_bounds_from_json(to_json(b), "run.json").robust);
+  EXPECT_FALSE(motion_bounds_from_json(nlohmann::json::object(), "run.json").robust);
+  try {
+    motion_bounds_from_json(nlohmann::json({{"robust", "yes"}}), "run.json");
+    FAIL() << "expected a UserError";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), "run.json: bounds.robust: expected true or false");
+  }
+}
+
+}  // namespace
+}  // namespace diverse
