@@ -7,11 +7,11 @@
 //                       ("vary": ["control"] or ["control", "shape"]), the optimizer's
 //                       options, the character's strength ("strength", 1 when absent),
 //                       the bounds on the variations ("bounds": {"effort": R,
-//                       "distance": X}, eval/motion_problem.h), version
+//                       "distance": X, "robust": true}, eval/motion_problem.h), version
 //   checkpoint.json     the optimizer's complete state at a generation boundary, written
 //                       atomically (temp + rename) every few seconds and at the end
 //   log.jsonl           one JSON record per CMA step (generation, variation, D, C, dmin,
-//                       evaluations)
+//                       evaluations, half-timestep checks and simulation steps so far)
 //   paths/m<i>.json     variation i's optimization path: where it stood after each of its
 //                       steps, as named controller parameters (and shape scales)
 //   summary.json        the result (run/outputs.h), written when the run ends
@@ -19,6 +19,8 @@
 //                       exact-replay record; model/m<i>.xml is the model it replays on
 //                       (with varying shape, each motion's own body: the exact shaped
 //                       MJCF text)
+//   robustness.json     the robustness suite on M0..MN (robust/robustness.h), written
+//                       when the run ends; summary.json has each motion's shares
 //   filmstrip.png       M0..MN at the same phase events, one row each
 //
 // Under `mpirun -n R` rank 0 does all of the above and the other ranks only evaluate

@@ -277,6 +277,32 @@ class PushHooks : public StepHooks {
   Evaluation& out_;
 };
 
+// Runs a rollout with a task's hooks (under the suite's push, if any) and fills in what
+// every kind of task reports of it: the rollout's stats, phases and failure, C, and when
+// the outcome was decided (Hooks: JumpHooks or WalkObserver).
+template <class Hooks>
+void simulate(const Task& task, const Character& body, const Controller& controller, JointDrive& drive,
+              Hooks& hooks, int max_steps, SimWorker& worker, const EvaluationOptions& options, Evaluation& e) {
+  if (options.push.time >= 0) {
+    PushHooks pushed(hooks, body, options.push, e);
+    e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
+  } else {
+    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+  }
+  e.phases = controller.phase_times();
+  if (e.stats.unstable) {
+    e.failed = true;
+    e.failure = "simulation unstable: " + e.stats.instability;
+    e.summary.unstable = true;
+  }
+  e.report = evaluate_constraints(task, e.summary);
+  e.constraint = e.report.total;
+  e.fell = e.report.fell;
+  e.decided_step = static_cast<int>(hooks.decided_at());
+  if (hooks.decided_at() >= 0)
+    e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
+}
+
 }  // namespace
 
 TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
@@ -427,24 +453,7 @@ Evaluation TaskEvaluator::evaluate_jump(Controller& controller, JointDrive& driv
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
   JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
-  if (options.push.time >= 0) {
-    PushHooks pushed(hooks, body, options.push, e);
-    e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
-  } else {
-    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
-  }
-  e.phases = controller.phase_times();
-  if (e.stats.unstable) {
-    e.failed = true;
-    e.failure = "simulation unstable: " + e.stats.instability;
-    e.summary.unstable = true;
-  }
-  e.report = evaluate_constraints(task_, e.summary);
-  e.constraint = e.report.total;
-  e.fell = e.report.fell;
-  e.decided_step = static_cast<int>(hooks.decided_at());
-  if (hooks.decided_at() >= 0)
-    e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
+  simulate(task_, body, controller, drive, hooks, max_steps, worker, options, e);
   if (!e.failed && options.samples_per_phase > 0 && e.has_flight() && e.summary.landed) {
     std::vector<double> taus;
     for (int k = 0; k < options.samples_per_phase; ++k) {
@@ -464,24 +473,7 @@ Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& driv
   mjModel* m = worker.model();
   WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, e);
   const int max_steps = static_cast<int>(std::ceil(task_.walk.max_time / m->opt.timestep)) + 1;
-  if (options.push.time >= 0) {
-    PushHooks pushed(hooks, body, options.push, e);
-    e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
-  } else {
-    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
-  }
-  e.phases = controller.phase_times();
-  if (e.stats.unstable) {
-    e.failed = true;
-    e.failure = "simulation unstable: " + e.stats.instability;
-    e.summary.unstable = true;
-  }
-  e.report = evaluate_constraints(task_, e.summary);
-  e.constraint = e.report.total;
-  e.fell = e.report.fell;
-  e.decided_step = static_cast<int>(hooks.decided_at());
-  if (hooks.decided_at() >= 0)
-    e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
+  simulate(task_, body, controller, drive, hooks, max_steps, worker, options, e);
   if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);
   return e;
 }

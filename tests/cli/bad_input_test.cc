@@ -372,7 +372,7 @@ TEST(BadInput, MotionFilesRunDirectoriesAndCheckpoints) {
       resume("run.json", run_with("/strength", "strong"), "run.json: strength: expected a number in [0.1, 10]"),
       resume("run.json", run_with("/bounds/effort", 0.5), "run.json: bounds.effort: expected a number in [1, 1e6]"),
       resume("run.json", run_with("/bounds/distance", -1), "run.json: bounds.distance: expected a number in (0, 1e12]"),
-      resume("run.json", run_with("/bounds/energy", 2), "run.json: bounds.energy: expected only the keys effort and distance"),
+      resume("run.json", run_with("/bounds/energy", 2), "run.json: bounds.energy: expected only the keys effort, distance and robust"),
       resume("run.json", run_with("/bounds", 3), "run.json: bounds: expected an object"),
       resume("run.json", run_with("/task_file", "/nonexistent/task.toml"), "run.json: task_file: /nonexistent/task.toml no longer exists"),
       resume("checkpoint.json", "", "checkpoint.json: not valid JSON"),
