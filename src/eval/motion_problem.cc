@@ -157,28 +157,27 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
 }
 
 void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, MotionOutcome& out) const {
-  const MotionOutcome coarse = out;
-  MotionOutcome* confirmed = &out;
+  const MotionOutcome::Landing& coarse = out.landing;
   EvaluationOptions fine_options;
   fine_options.samples_per_phase = 0;
   fine_options.timestep_scale = 0.5;
   MotionOutcome scratch;
   const Evaluation fine = run(x, worker, fine_options, scratch);
   MotionSummary landed;
-  landed.landed = coarse.landing.landed;
-  landed.fell = coarse.landing.fell;
-  landed.unstable = coarse.landing.unstable;
-  landed.touchdown_feet_x = coarse.landing.touchdown_x;
-  landed.touchdown_feet_y = coarse.landing.touchdown_y;
-  landed.feet_x = coarse.landing.rest_x;
-  landed.feet_y = coarse.landing.rest_y;
+  landed.landed = coarse.landed;
+  landed.fell = coarse.fell;
+  landed.unstable = coarse.unstable;
+  landed.touchdown_feet_x = coarse.touchdown_x;
+  landed.touchdown_feet_y = coarse.touchdown_y;
+  landed.feet_x = coarse.rest_x;
+  landed.feet_y = coarse.rest_y;
   const double penalty = half_timestep_term(evaluator_->task(), landed, fine.summary, fine.constraint).penalty;
   // In the order TaskEvaluator::evaluate adds it (0 + penalty), then the bounds' terms.
-  confirmed->task_constraint = coarse.task_constraint + penalty;
-  confirmed->constraint = confirmed->task_constraint;
-  confirmed->failed = !std::isfinite(confirmed->constraint);
-  if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(*confirmed);
-  confirmed->check_steps = fine.stats.steps;
+  out.task_constraint += penalty;
+  out.constraint = out.task_constraint;
+  out.failed = !std::isfinite(out.constraint);
+  if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(out);
+  out.check_steps = fine.stats.steps;
 }
 
 std::shared_ptr<const Outcome> MotionProblem::evaluate_confirmed(const Eigen::VectorXd& x,
