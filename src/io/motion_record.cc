@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -231,24 +232,19 @@ double replay_motion_file(const fs::path& json_path, int* steps) {
   fs::path model_path;
   const StepRecorder record = read_replay_record(motion, json_path, &model_path);
   const auto model = SharedModel::from_file(model_path.string());
-  mjModel* m = mj_copyModel(nullptr, model->get());
-  if (m->nq != record.nq || m->nu != record.nu || m->nv != static_cast<int>(record.qvel0.size())) {
-    mj_deleteModel(m);
+  // The copy is freed on every path out, the errors included; they read the model before.
+  const std::unique_ptr<mjModel, void (*)(mjModel*)> copy(mj_copyModel(nullptr, model->get()), mj_deleteModel);
+  const mjModel* m = copy.get();
+  if (m->nq != record.nq || m->nu != record.nu || m->nv != static_cast<int>(record.qvel0.size()))
     throw UserError(json_path.string() + ": replay: nq/nu do not match the model " + model_path.string());
-  }
   for (int dof : record.damped_dofs) {
-    if (dof >= m->nv) {
-      mj_deleteModel(m);
+    if (dof >= m->nv)
       throw UserError(json_path.string() + ": replay.damped_dofs: expected dof indices below the model's nv (" +
                       std::to_string(m->nv) + "), got " + std::to_string(dof));
-    }
   }
-  if (std::fabs(m->opt.timestep - record.timestep) > 0) {
-    mj_deleteModel(m);
+  if (std::fabs(m->opt.timestep - record.timestep) > 0)
     throw UserError(json_path.string() + ": replay.timestep: does not match the model's");
-  }
-  const double diff = replay(m, record);
-  mj_deleteModel(m);
+  const double diff = replay(copy.get(), record);
   if (steps) *steps = record.steps();
   return diff;
 }

@@ -38,7 +38,9 @@ fs::path scratch(const std::string& name) {
 void expect_user_error(const Case& c) {
   SCOPED_TRACE("diverse " + c.args);
   // Under a time limit: a hang fails the case (exit 124) instead of stalling the suite.
-  const cli_test::CliResult r = cli_test::run_cli(c.args + " </dev/null", "timeout 120");
+  // glibc fills freed memory with a pattern (MALLOC_PERTURB_), so a message that reads what
+  // an error path already freed comes out wrong instead of by luck right.
+  const cli_test::CliResult r = cli_test::run_cli(c.args + " </dev/null", "MALLOC_PERTURB_=165 timeout 120");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_EQ(r.output.rfind("diverse: error: ", 0), 0u) << r.output;
   EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << "expected one line: " << r.output;
@@ -338,6 +340,10 @@ TEST(BadInput, MotionFilesRunDirectoriesAndCheckpoints) {
     r[nlohmann::json::json_pointer(pointer)] = value;
     return r.dump();
   };
+  const std::size_t nv = motion["replay"]["qvel0"].size();
+  nlohmann::json past_the_dofs = motion;
+  past_the_dofs["replay"]["damped_dofs"] = nlohmann::json::array({nv + 3});
+  past_the_dofs["replay"]["damping"] = nlohmann::json::array();
   auto replay = [&](const std::string& text, const std::string& expected) {
     const fs::path copy = broken("motions/m1.json", text);
     return Case{"replay " + (copy / "motions/m1.json").string(), expected};
@@ -362,6 +368,10 @@ TEST(BadInput, MotionFilesRunDirectoriesAndCheckpoints) {
       replay(motion_with("/replay/damping", nlohmann::json::array({nlohmann::json{{"step", -5}, {"values", nlohmann::json::array()}}})), "replay.damping"),
       replay(motion_with("/replay/damped_dofs", nlohmann::json::array({100000})), "replay.damping: missing or malformed"),
       replay(motion_with("/replay/damped_dofs", nlohmann::json::array({-1})), "replay.damped_dofs: missing or malformed"),
+      // A dof index past the model's: the message names the model's nv, read before the
+      // model's copy is freed.
+      replay(past_the_dofs.dump(), "replay.damped_dofs: expected dof indices below the model's nv (" +
+                                       std::to_string(nv) + "), got " + std::to_string(nv + 3)),
       resume("run.json", "[]", "run.json: format: expected \"diverse.run\""),
       resume("run.json", run_with("/format", 5), "run.json: format: expected \"diverse.run\""),
       resume("run.json", run_with("/options/variations", 100000), "run.json: options: diversity options: variations must be in [1, 1000]"),
