@@ -135,6 +135,8 @@ std::shared_ptr<const Outcome> MotionProblem::evaluate(const Eigen::VectorXd& x,
   return outcome;
 }
 
+double robust_failure_penalty(const Task& task) { return task.constraints.weight * 0.005; }
+
 std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, const Outcome& outcome,
                                                       int worker) const {
   const auto& coarse = dynamic_cast<const MotionOutcome&>(outcome);
@@ -147,8 +149,7 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
     confirmed->robust_steps = verdict.steps;
     confirmed->robust_held = verdict.holds;
     if (!verdict.holds) {
-      const double penalty = evaluator_->task().constraints.weight * 0.1 * 0.1;
-      confirmed->task_constraint += penalty;
+      confirmed->task_constraint += robust_failure_penalty(evaluator_->task());
       confirmed->constraint = confirmed->task_constraint;
       if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(*confirmed);
     }
@@ -171,7 +172,10 @@ void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, 
   landed.touchdown_feet_y = coarse.touchdown_y;
   landed.feet_x = coarse.rest_x;
   landed.feet_y = coarse.rest_y;
-  const double penalty = half_timestep_term(evaluator_->task(), landed, fine.summary, fine.constraint).penalty;
+  double penalty = half_timestep_term(evaluator_->task(), landed, fine.summary, fine.constraint).penalty;
+  // A --robust run ranks a motion that fails at half the step below one that only fails
+  // the suite's part: the task itself is not met there.
+  if (bounds_.robust && penalty > 0) penalty += 2 * robust_failure_penalty(evaluator_->task());
   // In the order TaskEvaluator::evaluate adds it (0 + penalty), then the bounds' terms.
   out.task_constraint += penalty;
   out.constraint = out.task_constraint;

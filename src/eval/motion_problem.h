@@ -55,11 +55,16 @@ struct MotionBounds {
   double distance = 0;  // X > 0: d(M, M0) <= X in the problem's distance
   // `diverse run --robust`: a sample meets the task only if it also holds under the
   // robustness suite's small part (robust/robustness.h, robust_sample_suite()), judged
-  // where a variation would move to it (confirm()); one that does not gets the term
-  // "robust", K_c (0.1)^2, as a landing 10 cm out would.
+  // where a variation would move to it (confirm()); one that does not gets
+  // robust_failure_penalty(), and one that fails the half-timestep check twice that on
+  // top of its own term, so that it ranks below every sample that only misses the suite.
   bool robust = false;
   bool any() const { return effort > 0 || distance > 0 || robust; }
 };
+
+// The term of a sample that meets the task but not the suite's part: K_c (0.1)^2 / 2, as
+// a landing 7 cm out would cost.
+double robust_failure_penalty(const Task& task);
 // Ranges of the bounds (`--effort-bound`, `--max-distance`).
 constexpr double kMinEffortBound = 1.0, kMaxEffortBound = 1e6;
 constexpr double kMaxDistanceBound = 1e12;

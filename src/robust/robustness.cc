@@ -141,7 +141,10 @@ bool holds(const Evaluation& e) { return !e.failed && e.constraint == 0; }
 nlohmann::json rollout_json(const PerturbedRollout& r) {
   nlohmann::json j = {{"constraint", r.constraint}, {"holds", r.holds}};
   switch (r.kind) {
-    case PerturbationKind::kParameters: j["distance"] = r.distance; break;
+    case PerturbationKind::kParameters:
+      j["distance"] = r.distance;
+      if (!r.parameters.is_null()) j["parameters"] = r.parameters;
+      break;
     case PerturbationKind::kPush:
       j["phase"] = r.phase;
       j["direction"] = r.direction;
@@ -152,6 +155,7 @@ nlohmann::json rollout_json(const PerturbedRollout& r) {
     case PerturbationKind::kHalfTimestep: j["timestep_scale"] = r.timestep_scale; break;
   }
   if (!r.fall_reason.empty()) j["fell"] = r.fall_reason;
+  if (r.fell_after_touchdown >= 0) j["fell_after_touchdown"] = r.fell_after_touchdown;
   if (!r.failure.empty()) j["failure"] = r.failure;
   return j;
 }
@@ -249,7 +253,10 @@ std::vector<MotionRobustness> run_robustness_suite(const TaskEvaluator& evaluato
     r.holds = holds(e);
     r.failure = e.failed ? e.failure : "";
     r.fall_reason = e.fell ? e.summary.fall_reason : "";
+    if (e.fell && e.summary.landed && e.phases.landing() >= 0)
+      r.fell_after_touchdown = e.summary.end_time - e.phases.landing();
     if (r.kind == PerturbationKind::kPush) r.push_time = e.push_time;
+    if (r.kind == PerturbationKind::kParameters) r.parameters = job.parameters.to_json();
   });
   std::vector<MotionRobustness> results(motions.size());
   for (std::size_t m = 0; m < motions.size(); ++m) {

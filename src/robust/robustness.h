@@ -120,8 +120,12 @@ struct PerturbedRollout {
   bool holds = false;          // C == 0 and the rollout did not fail
   std::string failure;         // why the rollout failed (blew up), or ""
   std::string fall_reason;     // why it fell, or ""
-  // kParameters: |x' - x| (normalized units).
+  // s from the first touch-down to the fall; -1 when it did not fall or fell before landing.
+  double fell_after_touchdown = -1;
+  // kParameters: |x' - x| (normalized units), and the perturbed parameters (a parameter
+  // file's "parameters": `diverse simulate --params` shows the rollout).
   double distance = 0;
+  nlohmann::json parameters;
   // kPush: the ground phase ("takeoff" before take-off, "landing" after touch-down,
   // "steps" in a walk's evaluated steps, "motion" for the whole rollout), the direction,
   // the time (s) it was applied and the change of velocity (m/s, world frame).

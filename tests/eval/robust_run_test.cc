@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/rng.h"
 #include "core/thread_pool.h"
 #include "eval/motion_problem.h"
 #include "optimize/diversity.h"
@@ -86,6 +87,36 @@ TEST(RobustRun, ReturnsOnlyVariationsThatHold) {
   EXPECT_GT(moved, 0);
   EXPECT_GT(steps_of(opt.ledger(), "robustness", "held"), 0);
   EXPECT_GT(steps_of(opt.ledger(), "robustness", "failed"), 0);
+}
+
+// A --robust run ranks a sample that fails at half the step below every sample that only
+// misses the suite's part: perturbations of jump_high's input motion, of both kinds.
+TEST(RobustRun, HalfTimestepFailuresRankBelowSuiteMisses) {
+  const RobustFixture f("jump_high");
+  const MotionProblem plain(f.ev, Metric::kMassDistance, f.m0.normalized(), 1);
+  Rng rng(7);
+  double worst_suite_miss = 0, best_half_step_failure = 1e300;
+  int suite_misses = 0, half_step_failures = 0;
+  for (int k = 0; k < 40 && (suite_misses < 2 || half_step_failures < 2); ++k) {
+    Eigen::VectorXd x = f.m0.normalized();
+    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] += 0.005 * rng.normal();
+    const auto coarse = plain.evaluate(x, 0);
+    if (!coarse->provisional) continue;  // fails at the task's own step: not ranked here
+    const double c_plain = plain.confirm(x, *coarse, 0)->constraint;
+    const double c_robust = f.problem.evaluate_confirmed(x, 0)->constraint;
+    if (c_plain > 0) {
+      ++half_step_failures;
+      best_half_step_failure = std::min(best_half_step_failure, c_robust);
+      EXPECT_GE(c_robust, c_plain + 2 * robust_failure_penalty(f.task));
+    } else if (c_robust > 0) {
+      ++suite_misses;
+      worst_suite_miss = std::max(worst_suite_miss, c_robust);
+      EXPECT_EQ(c_robust, robust_failure_penalty(f.task));
+    }
+  }
+  ASSERT_GE(suite_misses, 1);
+  ASSERT_GE(half_step_failures, 1);
+  EXPECT_LT(worst_suite_miss, best_half_step_failure);
 }
 
 TEST(RobustRun, SettingRoundTripsAndBadValuesAreRefused) {
