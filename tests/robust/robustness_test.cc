@@ -196,6 +196,44 @@ TEST(Suite, SameOnOneAndTwoThreadsWithPushesInTheirGroundPhases) {
   EXPECT_NE(a["motions"][0]["kinds"]["parameters"].dump(), c["motions"][0]["kinds"]["parameters"].dump());
 }
 
+// robustness.json lets a user see a failure again: each parameter draw's parameters,
+// simulated again, give its C bit for bit, and a fall after landing says when it came.
+// jump_high's input motion: most of its perturbations fall after touch-down.
+TEST(Suite, RecordsEachDrawsParametersAndWhenAFallCame) {
+  const Fixture f("jump_high");
+  RobustnessSuite suite;
+  suite.parameter_samples = 6;
+  suite.push_samples = 4;
+  suite.friction_factors = {};
+  const std::vector<MotionUnderTest> motions{{"M0", 0, f.m0}};
+  ThreadPool pool(2);
+  const nlohmann::json j = robustness_json(f.ev, motions, suite, pool);
+  EvaluationOptions judged = plain();
+  judged.half_timestep_check = true;
+  int falls_after_landing = 0;
+  for (const nlohmann::json& r : j["motions"][0]["kinds"]["parameters"]["rollouts"]) {
+    ParameterSet drawn = f.m0;
+    drawn.set_from_json(r["parameters"], "robustness.json");
+    const Evaluation e = f.ev.evaluate_named(drawn, judged);
+    EXPECT_TRUE(same_bits(e.constraint, r["constraint"].get<double>())) << r.dump();
+    EXPECT_EQ(e.fell, r.contains("fell"));
+  }
+  for (const char* kind : {"parameters", "pushes"}) {
+    for (const nlohmann::json& r : j["motions"][0]["kinds"][kind]["rollouts"]) {
+      if (!r.contains("fell_after_touchdown")) continue;
+      ++falls_after_landing;
+      EXPECT_TRUE(r.contains("fell")) << r.dump();
+      EXPECT_GE(r["fell_after_touchdown"].get<double>(), 0.0);
+      EXPECT_LE(r["fell_after_touchdown"].get<double>(), f.ev.task().simulation.settle_max + 1e-9);
+    }
+    for (const nlohmann::json& r : j["motions"][0]["kinds"][kind]["rollouts"]) {
+      if (r["holds"].get<bool>()) EXPECT_FALSE(r.contains("fell_after_touchdown")) << r.dump();
+    }
+  }
+  EXPECT_GT(falls_after_landing, 0);
+  EXPECT_FALSE(j["motions"][0]["kinds"]["pushes"]["rollouts"][0].contains("parameters"));
+}
+
 // The planar human is pushed forward and backward only, in its plane.
 TEST(Suite, PlanarCharactersArePushedInTheirPlane) {
   const Fixture f("jump_high");
