@@ -111,7 +111,8 @@ std::shared_ptr<const ControllerConfig> JumpControllerConfig::with_landing_heigh
 std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const TomlReader& r) const {
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
           "balance_kp",
-          "balance_kd", "balance_max_force", "gravity_compensation"});
+          "balance_kd", "balance_max_force", "gravity_compensation", "stance_landing",
+          "stand_after", "stand_duration"});
   auto c = std::make_shared<JumpControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -123,6 +124,10 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
   c->gravity_compensation = r.number("gravity_compensation", 0, 2, c->gravity_compensation);
+  c->stance_landing = r.boolean("stance_landing", c->stance_landing);
+  c->stand_after = r.number("stand_after", -1, 5, c->stand_after);
+  c->stand_duration = r.number("stand_duration", 0.05, 5, c->stand_duration);
+  if (c->stand_after >= 0 && !c->stance_landing) r.fail("stand_after", "expected stance_landing = true with it");
   return c;
 }
 
@@ -260,6 +265,7 @@ void JumpController::reset(const mjModel* m, const mjData* d) {
   times_.begin[kStart] = d->time;
   takeoff_com_z_ = 0;
   free_since_ = -1;
+  if (config_.stance_landing) stance_ = std::make_unique<StanceController>(body_, m);
 }
 
 void JumpController::enter(int phase, double time) {
@@ -297,6 +303,53 @@ void JumpController::enter(int phase, double time) {
     case kLand: phase_duration_ = land_duration_; break;
     default: phase_duration_ = start_duration_; break;
   }
+}
+
+// stance_landing, at touch-down: the world pitches to move from (as the stance controller
+// measures them) and to (the land pose's pelvis, chest and foot values), and the gains.
+void JumpController::enter_stance_landing(const mjData* d) {
+  const StanceController::Pitches p = stance_->measured_pitches(d);
+  land_from_ = {p.root, p.torso, p.foot};
+  const auto& pose = pose_[kLand];
+  const double root = pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])];
+  const double torso = chest_ >= 0 ? pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(chest_)])] : root;
+  land_goal_ = {root, torso, pose[static_cast<size_t>(pose_slot_[static_cast<size_t>(ankle_)])]};
+  // The land phase's gains for the knees and the feet's world tracking, the character's
+  // for the rest; the root (which the stance hips hold) keeps the stance controller's own
+  // gains, 2 M g h0 (the land phase's hip gains made the landing chatter).
+  for (size_t i = 0; i < body_.joints.size(); ++i) {
+    const JointGroup& g = body_.groups[static_cast<size_t>(body_.joints[i].group)];
+    const int gs = gain_slot_[static_cast<size_t>(body_.joints[i].group)];
+    // The strength model scales every joint's PD gains (Character::strength).
+    const double kp = gs >= 0 ? kp_[kLand][static_cast<size_t>(gs)] : g.kp;
+    const double kd = gs >= 0 ? kd_[kLand][static_cast<size_t>(gs)] : g.kd;
+    stance_->set_joint_gains(static_cast<int>(i), body_.strength * kp, body_.strength * kd);
+  }
+  const double h = stance_->heading();
+  stance_->set_com_offset(balance_offset_ * std::cos(h), balance_offset_ * std::sin(h));
+  stance_->set_com_velocity(0, 0);
+  stance_->set_com_force(StanceController::ComForce::kSupport);
+}
+
+// stance_landing, every step of the land phase: the pitches and the other joints' targets
+// a fraction s of the way to the land pose, then stance control.
+void JumpController::control_stance_landing(const mjModel* m, const mjData* d, JointDrive& drive, double s) {
+  // stand_after: a fraction u of the way on from the land pose to standing (the tracked
+  // links level, every other joint at the model's qpos0).
+  double u = 0;
+  if (config_.stand_after >= 0) {
+    u = std::clamp((d->time - phase_begin_ - land_duration_ - config_.stand_after) / config_.stand_duration, 0.0, 1.0);
+  }
+  auto at = [&](int k) {
+    const double pitch = land_from_[static_cast<size_t>(k)] + s * (land_goal_[static_cast<size_t>(k)] - land_from_[static_cast<size_t>(k)]);
+    return (1 - u) * pitch;
+  };
+  stance_->set_pitches(at(0), at(1), at(2));
+  if (u > 0) {
+    for (size_t i = 0; i < target_.size(); ++i) target_[i] += u * (m->qpos0[body_.joints[i].qpos] - target_[i]);
+  }
+  stance_->set_targets(target_);
+  stance_->control(m, d, drive);
 }
 
 // World pitch (rad) of joint j's parent link.
@@ -424,6 +477,15 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
       if (w > 0) goal = (1 - w) * goal + w * landing_hip_goal(i, d);
       target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + s * (goal - from_[static_cast<size_t>(i)]);
     }
+  }
+
+  if (stance_ && phase_ == kLand) {
+    if (phase_changed_) {
+      stance_->reset(m, d);  // the heading and footing it landed with
+      enter_stance_landing(d);
+    }
+    control_stance_landing(m, d, drive, s);
+    return;
   }
 
   // Balance: tau = J^T F on the stance legs.

@@ -15,7 +15,9 @@
 //           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g) from the peak (from
 //           the current height and fall speed when open_rotation ends the rise later;
 //           targets reached sooner with open_time); optional landing controller (below)
-//   land    stance, balance, targets interpolated over land.duration, then held
+//   land    stance, balance, targets interpolated over land.duration, then held (with
+//           the config's stance_landing, by stance control; with stand_after, then
+//           standing up)
 //
 // The character (character/character.h) needs a planar root and joint groups with the
 // roles hip, knee and ankle; any other groups (waist, shoulder, elbow, wrist, ...) are
@@ -61,6 +63,7 @@
 #include "character/character.h"
 #include "control/controller.h"
 #include "control/parameters.h"
+#include "control/stance_controller.h"
 #include "physics/com_velocity.h"
 
 namespace diverse {
@@ -93,6 +96,19 @@ struct JumpControllerConfig : ControllerConfig {
   // far since take-off, so a flip opens for its landing when it has come round, as a
   // gymnast opens when the floor comes into view; 0 = the fall phase begins at the peak.
   double open_rotation = 0;
+  // true: the land phase runs stance control (control/stance_controller.h), as the 3D
+  // jumps' does: the J^T force on the COM held so that its centre of pressure stays inside
+  // the soles, the pelvis's world pitch held by the stance legs, the feet tracking theirs, the chest
+  // tracked with the waist; the land pose's pelvis, chest and foot values become those
+  // links' world pitches, reached over land.duration from where they were at touch-down.
+  // false: the paper's land phase (PD toward the land pose plus the J^T balance above).
+  bool stance_landing = false;
+  // s; >= 0 (with stance_landing): this long after the land phase has reached its pose,
+  // stand up from it over stand_duration, to the tracked links level and every other joint
+  // at the model's qpos0, instead of holding a deep landing crouch until it gives way;
+  // < 0: hold the land pose.
+  double stand_after = -1;
+  double stand_duration = 0.5;  // s
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -143,6 +159,8 @@ class JumpController : public Controller {
   double to_local(int j, const double* qpos, double world) const;
   double to_world(int j, const double* qpos, double local) const;
   double landing_hip_goal(int j, const mjData* d) const;
+  void enter_stance_landing(const mjData* d);
+  void control_stance_landing(const mjModel* m, const mjData* d, JointDrive& drive, double s);
 
   const Character& body_;
   JumpControllerConfig config_;
@@ -176,6 +194,10 @@ class JumpController : public Controller {
   std::vector<double> balance_; // per joint: J^T F of this step (Nm)
   std::array<double, 3> com_{}, com_vel_{};
   SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
+  // stance_landing: the land phase's stance control, made by reset(), and the world
+  // pitches (root, torso, feet) it moves from (at touch-down) and to (the land pose).
+  std::unique_ptr<StanceController> stance_;
+  std::array<double, 3> land_from_{}, land_goal_{};
   double gravity_ = 9.81;
 };
 

@@ -181,9 +181,8 @@ mjData* scratch_data(const mjModel* m) {
 
 StanceController::StanceController(const Character& body, const mjModel* m, StanceGains gains)
     : body_(body), gains_(gains) {
-  if (body.root != RootKind::kFree) {
-    throw std::invalid_argument("StanceController: needs a character with a free root");
-  }
+  // A planar root (x, z, pitch) works as well: every quantity is taken in the world, and
+  // what lies out of the plane (lateral forces, roll and yaw) turns no hinge of the plane.
   const int n = body.dof();
   const int root = body.root_body;
   targets_.resize(static_cast<size_t>(n));
@@ -318,7 +317,10 @@ std::vector<double> StanceController::standing_pose(const mjModel* m) const {
       for (int s = 0; s < 2; ++s)
         shift += d->xpos[3 * body_.feet[static_cast<size_t>(s)] + i] -
                  foot0[static_cast<size_t>(s)][static_cast<size_t>(i)];
-      d->qpos[body_.root_qpos + i] -= shift / 2;
+      // World x and z: a free root's position, or a planar root's slides.
+      const int slot = body_.root == RootKind::kPlanar ? (i == 0 ? body_.root_x_qpos : body_.root_z_qpos)
+                                                       : body_.root_qpos + i;
+      d->qpos[slot] -= shift / 2;
     }
     mj_kinematics(m, d);
     mj_comPos(m, d);
@@ -388,7 +390,9 @@ void StanceController::reset(const mjModel* m, const mjData* d) {
   measure(m, d);
   height_target_ = com_[2];
   const int root = body_.root_body;
-  heading_ = yaw_of(d->xquat + 4 * root);
+  // A planar character faces along its plane whatever its pitch (a root pitched past 90
+  // degrees would turn the yaw of its x axis round).
+  heading_ = body_.root == RootKind::kPlanar ? yaw_of(root_standing_.data()) : yaw_of(d->xquat + 4 * root);
   const double turn = heading_ - yaw_of(root_standing_.data());
   heading_quat_ = {std::cos(turn / 2), 0, 0, std::sin(turn / 2)};
   update_targets();

@@ -1,4 +1,5 @@
-// Stance control for a character with a free root (the 3D human, the bird robot): balance
+// Stance control for a character with a free root (the 3D human, the bird robot) or a
+// planar one (the land phase of "jump2d" with stance_landing): balance
 // on the feet in contact, body upright, feet flat, every other joint toward a pose.
 //
 //   StanceController stance(body, m);        // targets: the model's standing pose qpos0
@@ -87,7 +88,7 @@ struct StanceGains {
 
 class StanceController {
  public:
-  // `m` is the model `body` was bound to (free root: std::invalid_argument otherwise).
+  // `m` is the model `body` was bound to (a free root, or a planar one: x, z, pitch).
   // Targets start at the model's standing pose (qpos0 of every joint of the character).
   StanceController(const Character& body, const mjModel* m, StanceGains gains = {});
 

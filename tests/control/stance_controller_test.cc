@@ -343,6 +343,45 @@ TEST_P(Stance3d, FilmStrip) {
   std::printf("film strip: %s\n", out.string().c_str());
 }
 
+// The planar human (a root of x, z and pitch): stance control as the land phase of
+// "jump2d" runs it (stance_landing), with knee and foot gains (its character file leaves
+// the hips, knees and ankles to the jump's phases).
+Outcome stand_planar(const std::array<double, 3>& v, double seconds) {
+  const Loaded c = load("human2d");
+  SimWorker worker(c.model);
+  worker.reset();
+  mjModel* m = worker.model();
+  mjData* d = worker.data();
+  StanceController stance(c.body, m);
+  for (std::size_t k = 0; k < c.body.joints.size(); ++k) {
+    const JointRole role = c.body.groups[static_cast<std::size_t>(c.body.joints[k].group)].role;
+    if (role == JointRole::kKnee || role == JointRole::kAnkle) stance.set_joint_gains(static_cast<int>(k), 300, 30);
+  }
+  const std::vector<double> pose = stance.standing_pose(m);
+  mju_copy(d->qpos, pose.data(), m->nq);
+  d->qvel[c.body.root_x_dof] = v[0];
+  mj_forward(m, d);
+  stance.reset(m, d);
+  JointDrive drive = drive_for(c.body);
+  Outcome out;
+  StanceHooks hooks(c.body, stance, drive, out);
+  hooks.start(m, d);
+  StepRecorder record;
+  out.stats = run_rollout(worker, hooks, static_cast<int>(std::lround(seconds / m->opt.timestep)), drive, &record);
+  mjModel* plain = mj_copyModel(nullptr, c.model->get());
+  out.torque = check_net_torque(plain, record, drive.joints());
+  mj_deleteModel(plain);
+  return out;
+}
+
+TEST(Stance2d, StandsAndRecoversFromPushesInItsPlane) {
+  for (double v : {0.0, 0.3, -0.3}) {
+    const Outcome o = stand_planar({v, 0, 0}, 10.0);
+    std::printf("human2d %+.1f m/s: %s\n", v, describe(o).c_str());
+    expect_stood(o, "human2d at " + std::to_string(v) + " m/s");
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Characters, Stance3d, ::testing::Values("human3d", "robot3d"),
                          [](const ::testing::TestParamInfo<const char*>& param_info) {
                            return std::string(param_info.param);

@@ -1,0 +1,104 @@
+// "jump2d" with stance_landing and stand_after (control/jump_controller.h): the land phase
+// run by stance control, then standing up. On jump_forward's input motion: it still meets
+// the task at both timesteps, and it holds pushes forward 0.3 to 0.9 s after touch-down that the
+// paper's land phase (PD toward the land pose plus J^T balance) falls from. Bad settings
+// of the two keys are refused with the task file's field.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/error.h"
+#include "task/evaluate.h"
+#include "task/task.h"
+
+namespace diverse {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kSource = DIVERSE_SOURCE_DIR;
+
+// jump_forward.toml with `lines` at the top of its [controller] table, written to a
+// scratch directory with its relative paths made absolute.
+fs::path variant(const std::string& name, const std::string& lines) {
+  std::ifstream in(kSource + "/tasks/jump_forward.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    if (at == std::string::npos) throw std::runtime_error("jump_forward.toml has no " + from);
+    text.replace(at, from.size(), to);
+  };
+  // The committed file's own landing keys give way to the variant's.
+  for (const char* key : {"stance_landing =", "stand_after =", "stand_duration ="}) {
+    for (auto at = text.find(std::string("\n") + key); at != std::string::npos; at = text.find(std::string("\n") + key))
+      text.erase(at + 1, text.find('\n', at + 1) - at);
+  }
+  replace("character = \"../", "character = \"" + kSource + "/");
+  replace("m0 = \"", "m0 = \"" + kSource + "/tasks/");
+  replace("base = \"", "base = \"" + kSource + "/tasks/");
+  replace("[controller]\n", "[controller]\n" + lines + "\n");
+  const fs::path dir = fs::temp_directory_path() / "diverse_stance_landing";
+  fs::create_directories(dir);
+  const fs::path file = dir / (name + ".toml");
+  std::ofstream(file) << text;
+  return file;
+}
+
+EvaluationOptions judged() {
+  EvaluationOptions o;
+  o.samples_per_phase = 0;
+  o.half_timestep_check = true;
+  return o;
+}
+
+TEST(StanceLanding, MeetsTheTaskAndHoldsForwardPushesAfterTouchdown) {
+  const Task paper_task = load_task(variant("paper", "stance_landing = false\nstand_after = -1").string());
+  const Task stance_task = load_task(variant("stance", "stance_landing = true\nstand_after = 0.0").string());
+  const TaskEvaluator paper(paper_task), stance(stance_task);
+  const ParameterSet m0 = paper.load_parameters(paper_task.m0);
+  auto pw = paper.make_worker();
+  auto sw = stance.make_worker();
+  const Evaluation p0 = paper.evaluate(m0.values(), *pw, judged());
+  const Evaluation s0 = stance.evaluate(m0.values(), *sw, judged());
+  ASSERT_EQ(p0.constraint, 0.0);
+  ASSERT_EQ(s0.constraint, 0.0) << s0.summary.fall_reason;
+  // The same jump up to touch-down; the landing differs.
+  EXPECT_EQ(s0.phases.landing(), p0.phases.landing());
+  EXPECT_EQ(s0.summary.touchdown_feet_x, p0.summary.touchdown_feet_x);
+  EXPECT_NE(s0.summary.feet_x, p0.summary.feet_x);
+
+  int paper_held = 0, stance_held = 0;
+  for (double after : {0.3, 0.5, 0.7, 0.9}) {
+    EvaluationOptions o = judged();
+    o.push.time = p0.phases.landing() + after;
+    o.push.dv = {0.3, 0, 0};
+    const Evaluation p = paper.evaluate(m0.values(), *pw, o);
+    const Evaluation s = stance.evaluate(m0.values(), *sw, o);
+    ASSERT_GE(s.push_time, 0);
+    std::printf("push 0.3 m/s forward %.1f s after touch-down: paper C %g (%s), stance C %g (%s)\n", after,
+                p.constraint, p.summary.fall_reason.c_str(), s.constraint, s.summary.fall_reason.c_str());
+    paper_held += p.constraint == 0 && !p.failed;
+    stance_held += s.constraint == 0 && !s.failed;
+  }
+  EXPECT_GE(stance_held, 3);
+  EXPECT_LT(paper_held, stance_held);
+}
+
+TEST(StanceLanding, BadSettingsAreRefused) {
+  auto refused = [](const std::string& lines, const std::string& expected) {
+    try {
+      load_task(variant("bad", lines).string());
+      ADD_FAILURE() << "expected a UserError for " << lines;
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("stance_landing = false\nstand_after = 0.2", "controller.stand_after: expected stance_landing = true with it");
+  refused("stance_landing = true\nstand_after = 9", "controller.stand_after: expected a number in");
+  refused("stance_landing = true\nstand_duration = 0", "controller.stand_duration: expected a number in");
+  refused("stance_landing = 1", "controller.stance_landing");
+}
+
+}  // namespace
+}  // namespace diverse
