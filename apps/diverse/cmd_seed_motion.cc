@@ -2,9 +2,14 @@
 // constraint penalty, starting from the hand-authored jump the task names
 // ([seed] base), with continuation on the scene object's height where the task asks for
 // it (src/task/seed_motion.h), and writes the parameters to the task's m0 file.
-// `--robustness-check` instead measures a motion (by default the task's M0): its C at
-// the task's timestep and with it halved, and how many random perturbations of its
-// normalized parameters still meet the task.
+// With `--robust`, a candidate that meets the task counts only if it also holds under the
+// robustness suite's small part (robust/robustness.h, robust_sample_suite(): what
+// `diverse run --robust` asks of its samples); one that does not gets
+// robust_failure_penalty() added to its C, so the m0 file only ever receives a motion
+// that holds it. `--robustness-check` instead measures a motion (by default the task's
+// M0): its C at the task's timestep and with it halved, how many random perturbations of
+// its normalized parameters still meet the task, and with `--robust` whether it holds the
+// suite's part.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -15,8 +20,11 @@
 
 #include "command.h"
 #include "options.h"
-#include "io/files.h"
 #include "core/error.h"
+#include "core/thread_pool.h"
+#include "eval/motion_problem.h"
+#include "io/files.h"
+#include "robust/robustness.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
 
@@ -38,11 +46,12 @@ struct SeedArgs {
   int check_samples = 32;
   int from_stage = 0;
   double strength = 1.0;
+  bool robust = false;
 };
 
 // The options that change what is searched for (not how long or from where), as they
 // must be given again to go on from a partial result or a stage: strength, flight
-// rotation and the robustness term.
+// rotation, the robustness term and --robust.
 std::string searched_options(const SeedArgs& args) {
   auto number = [](double v) {
     char text[32];
@@ -56,6 +65,7 @@ std::string searched_options(const SeedArgs& args) {
     options += " --perturbations " + std::to_string(args.perturbations) + " --perturbation-sigma " +
                number(args.perturbation_sigma);
   }
+  if (args.robust) options += " --robust";
   return options;
 }
 
@@ -73,6 +83,36 @@ std::string output_stem(const std::string& path) {
       return path.substr(0, path.size() - suffix.size());
   }
   return path;
+}
+
+// The robustness suite's part (--robust) as "2 parameter perturbations at sigma 0.02 and 2
+// pushes of 0.3 m/s in the landing".
+std::string describe_part(const RobustnessSuite& suite, const std::vector<PerturbedRollout>& rollouts) {
+  std::string phase;
+  for (const PerturbedRollout& r : rollouts) {
+    if (r.kind != PerturbationKind::kPush) continue;
+    phase = r.phase == "landing" ? " in the landing" : r.phase == "steps" ? " in the evaluated steps" : "";
+    break;
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, "%d parameter perturbations at sigma %g and %d pushes of %g m/s%s",
+                suite.parameter_samples, suite.sigma, suite.push_samples, suite.push_speed, phase.c_str());
+  return text;
+}
+
+// --robustness-check --robust: whether the motion holds the suite's part, as the search
+// and `diverse run --robust` judge it (check_suite), with every rollout's outcome.
+void robust_check(const TaskEvaluator& ev, const ParameterSet& p, int threads) {
+  const RobustnessSuite suite = robust_sample_suite();
+  const SuiteVerdict verdict = check_suite(ev, p, suite);
+  ThreadPool pool(threads);
+  const MotionRobustness all = run_robustness_suite(ev, {MotionUnderTest{"M0", 0, p}}, suite, pool).front();
+  const int needed = static_cast<int>(std::ceil(suite.required_share * all.count() - 1e-9));
+  std::printf("  the robustness suite's part (--robust: %s): %s, %d of %d perturbed rollouts meet the task "
+              "(params %d/%d, pushes %d/%d; %d needed)\n",
+              describe_part(suite, all.rollouts).c_str(), verdict.holds ? "holds" : "does not hold", all.held(),
+              all.count(), all.held(PerturbationKind::kParameters), all.count(PerturbationKind::kParameters),
+              all.held(PerturbationKind::kPush), all.count(PerturbationKind::kPush), needed);
 }
 
 void check(const SeedArgs& args) {
@@ -95,6 +135,7 @@ void check(const SeedArgs& args) {
     std::printf("  sigma %g: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
                 l.samples, 100 * l.fraction());
   }
+  if (args.robust) robust_check(ev, p, args.threads);
 }
 
 void run(const SeedArgs& args) {
@@ -114,6 +155,17 @@ void run(const SeedArgs& args) {
   options.perturbation_sigma = args.perturbation_sigma;
   options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
   options.first_stage = args.from_stage;
+  if (args.robust) {
+    // What `diverse run --robust` asks of its samples, with the same penalty for a miss.
+    options.requirement.name = "robust part";
+    options.requirement.penalty = robust_failure_penalty(task);
+    options.requirement.check = [&ev](const ParameterSet& p) {
+      const SuiteVerdict v = check_suite(ev, p, robust_sample_suite());
+      // The unperturbed rollout that gives the push moments, the perturbed ones and their
+      // half-timestep checks.
+      return SeedRequirement::Verdict{v.holds, 1LL + v.rollouts + v.half_timestep_checks};
+    };
+  }
   options.log = [](const std::string& line) { std::printf("%s\n", line.c_str()); std::fflush(stdout); };
   const std::string m0_path = args.out.empty() ? task.m0 : args.out;
   const std::string stem = output_stem(m0_path);
@@ -135,11 +187,12 @@ void run(const SeedArgs& args) {
     std::fflush(stdout);
   };
   const SeedResult r = seed_motion(task, start, options);
-  // The task's m0 file only ever holds a motion that meets the task; a search that falls
-  // short writes its best attempt beside it, to continue from with --start. With
-  // perturbations, a robust near miss that ranks above the motion that meets the task is
-  // written there too: it is the better place to continue from.
-  const bool met = r.constraint == 0;
+  // The task's m0 file only ever holds a motion that meets the task (with --robust, that
+  // also holds the robustness suite's part: its C includes the penalty otherwise); a
+  // search that falls short writes its best attempt beside it, to continue from with
+  // --start. With perturbations, a robust near miss that ranks above the motion that
+  // meets the task is written there too: it is the better place to continue from.
+  const bool met = r.constraint == 0 && !r.requirement_failed;
   const std::string partial_path = stem + ".partial.json";
   // The command as the user gave it: --start only when it was given (the task's [seed]
   // base otherwise, named relative to the task file).
@@ -166,8 +219,15 @@ void run(const SeedArgs& args) {
   };
   const std::string out = met ? m0_path : partial_path;
   write(out, r.parameters, r.constraint);
-  std::printf("C=%.6g margin=%.3f robustness=%.3f fell=%d evaluations=%lld seconds=%.1f -> %s\n",
-              r.constraint, r.margin, r.robustness, r.fell ? 1 : 0, r.evaluations, r.seconds,
+  std::string robust;
+  if (args.robust) {
+    // Judged only on a result that meets the task at both timesteps.
+    robust = std::string(" robust=") + (r.requirement_failed ? "fails" : met ? "holds" : "n/a") + " (" +
+             std::to_string(r.requirement_held) + " of " + std::to_string(r.requirement_checks) +
+             " candidates that met the task held the suite's part)";
+  }
+  std::printf("C=%.6g margin=%.3f robustness=%.3f fell=%d evaluations=%lld seconds=%.1f%s -> %s\n",
+              r.constraint, r.margin, r.robustness, r.fell ? 1 : 0, r.evaluations, r.seconds, robust.c_str(),
               out.c_str());
   if (met && !r.lowest_mean_meets && args.perturbations > 0) {
     nlohmann::json j;
@@ -179,6 +239,11 @@ void run(const SeedArgs& args) {
     std::printf("a more robust candidate that does not meet the task yet (mean C = %.6g) -> %s\n",
                 r.lowest_mean_f, partial_path.c_str());
   }
+  if (!met && r.requirement_failed)
+    throw UserError(task.file + ": no motion meeting the task and holding the robustness suite's part (--robust) "
+                    "was found (the best meets the task but not the part, C = " + std::to_string(r.constraint) +
+                    "); continue with `diverse seed-motion " + args.task + " --start " + out +
+                    searched_options(args) + "`");
   if (!met)
     throw UserError(task.file + ": no motion meeting the task was found (best C = " +
                     std::to_string(r.constraint) + "); continue with `diverse seed-motion " +
@@ -218,6 +283,11 @@ void install(CLI::App& app) {
                   "Start at this continuation stage (0 = the first); every stage's result is "
                   "written to <m0 stem>.stage<k>.json to go on from")
       ->check(integer_in(0, 100));
+  cmd->add_flag("--robust", args->robust,
+                "A candidate meets the task only if it also holds under the robustness suite's "
+                "small part, as `diverse run --robust` judges samples (2 parameter perturbations, "
+                "2 pushes in the landing; 3 of 4 must hold); with --robustness-check, report "
+                "whether the motion holds it (docs/robustness.md)");
   cmd->add_flag("--robustness-check", args->robustness_check,
                 "Measure a motion instead of searching (default: the task's M0, or --start)");
   cmd->add_option("--check-sigmas", args->check_sigmas,

@@ -17,6 +17,7 @@
 #include "task/task.h"
 #include "render/run_problem.h"
 #include "render/view_plan.h"
+#include "robust/robustness.h"
 
 // Where the build put the page template (set for this file by the top-level CMakeLists).
 #ifndef DIVERSE_GALLERY_TEMPLATE
@@ -352,6 +353,64 @@ nlohmann::json shape_data(const nlohmann::json& summary) {
   return {{"names", names}, {"scales", scales}};
 }
 
+// Each motion's shares of the robustness suite (robust/robustness.h) that every run ends
+// with: from RUN/robustness.json when it is there (`diverse robustness RUN` may have
+// measured the run again since), else from summary.json "robustness". Null for a run
+// with neither (made before the suite), with a note: the page says the suite was not
+// run. Per motion of the run (matched by label; null where the file has no entry for it):
+// {"held", "count", "share", "kinds": {KIND: {"held", "count"}}}, KIND as robustness.json
+// names them. A malformed file is a UserError naming it and the field, as in `diverse
+// report`.
+nlohmann::json robustness_data(const RunView& run, nlohmann::json& notes) {
+  const fs::path file = run.dir / "robustness.json";
+  nlohmann::json source;
+  std::string origin;
+  if (fs::exists(file)) {
+    source = read_json(file);
+    origin = file.string();
+    if (!source.is_object() || source.value("format", std::string()) != "diverse.robustness")
+      throw_field_error(origin, "format", "expected \"diverse.robustness\" (written by `diverse robustness`)");
+  } else if (run.summary.contains("robustness")) {
+    source = run.summary["robustness"];
+    origin = (run.dir / "summary.json").string();
+  } else {
+    notes.push_back("robustness suite not run on these motions: diverse robustness " + run.dir.string() +
+                    " runs it, then make the gallery again");
+    return nullptr;
+  }
+  const std::string prefix = origin.ends_with("summary.json") ? "robustness." : "";
+  if (!source.is_object() || !source.contains("motions") || !source["motions"].is_array())
+    throw_field_error(origin, prefix + "motions", "expected a list of motions");
+  nlohmann::json motions = nlohmann::json::array();
+  for (const RunMotion& motion : run.motions) {
+    nlohmann::json entry = nullptr;
+    for (const nlohmann::json& m : source["motions"]) {
+      if (!m.is_object() || !m.contains("label") || !m["label"].is_string())
+        throw_field_error(origin, prefix + "motions[].label", "expected a motion's label");
+      if (m["label"] != motion.label) continue;
+      (void)robustness_shares(m, origin);  // every kind's counts, checked
+      nlohmann::json kinds = nlohmann::json::object();
+      long long held = 0, count = 0;
+      for (int k = 0; k < kPerturbationKinds; ++k) {
+        const char* key = perturbation_key(static_cast<PerturbationKind>(k));
+        const nlohmann::json& kind = m["kinds"][key];
+        kinds[key] = {{"held", kind["held"]}, {"count", kind["count"]}};
+        held += kind["held"].get<long long>();
+        count += kind["count"].get<long long>();
+      }
+      entry = {{"held", held},
+               {"count", count},
+               {"share", count > 0 ? static_cast<double>(held) / static_cast<double>(count) : 0.0},
+               {"kinds", kinds}};
+      break;
+    }
+    motions.push_back(entry);
+  }
+  return {{"source", fs::path(origin).filename().string()},
+          {"suite", source.value("suite", nlohmann::json::object())},
+          {"motions", motions}};
+}
+
 }  // namespace
 
 fs::path gallery_template_path() {
@@ -510,6 +569,7 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
   data["shape"] = shape_data(s);
   data["notes"] = nlohmann::json::array();
   if (!run.task_note.empty()) data["notes"].push_back("landing region not drawn: " + run.task_note);
+  data["robustness"] = robustness_data(run, data["notes"]);
   if (options.paths && run.motions.size() > 1) {
     data["paths"] = path_data(run, options, models);
   } else {

@@ -27,6 +27,10 @@
 //     step of each), D of the current set, D of the best set so far, and every motion's
 //     constraint value C and dmin; at most max_progress_points generations, thinned evenly;
 //   - for a run whose bodies varied, every motion's link-length scales (summary.json);
+//   - every motion's shares of the robustness suite (robust/robustness.h), over all and
+//     by kind, from RUN/robustness.json, or from summary.json "robustness" without it;
+//     null (and a note) for a run with neither, made before every run ended with the
+//     suite: the page says the suite was not run;
 //   - the run's blends, when `diverse blend RUN` made them (run/blend.h, RUN/blend/): per
 //     blend its weights on M0..MN, C, whether it meets the task, its distances to the
 //     motions and its frames (from its motion file), and the share that meets the task,

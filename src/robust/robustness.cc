@@ -222,6 +222,7 @@ SuiteVerdict check_suite(const TaskEvaluator& evaluator, const ParameterSet& par
   for (const Job& job : jobs) {
     const Evaluation e = evaluator.evaluate_named(job.parameters, job.options);
     ++verdict.rollouts;
+    verdict.half_timestep_checks += e.check_steps > 0 ? 1 : 0;
     verdict.steps += e.stats.steps + e.check_steps;
     if (!holds(e) && ++failed > allowed) {
       verdict.holds = false;

@@ -97,6 +97,7 @@ RobustnessSuite robust_sample_suite();
 struct SuiteVerdict {
   bool holds = true;
   int rollouts = 0;      // perturbed rollouts run
+  int half_timestep_checks = 0;  // of them, those checked again at half the timestep
   long long steps = 0;
 };
 SuiteVerdict check_suite(const TaskEvaluator& evaluator, const ParameterSet& parameters,

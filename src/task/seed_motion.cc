@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -102,6 +104,11 @@ struct Scored {
   double margin = 0;      // smallest constraint_margin of the two
   double met = 0;         // fraction of the perturbations with C = 0 (0 if none)
   bool fell = true;
+  // The requirement (SeedOptions::requirement), when it was judged: on a candidate that
+  // met the task at both timesteps. A failure is in `constraint` as its penalty.
+  bool checked = false;
+  bool held = false;
+  long long check_rollouts = 0;
   bool meets() const { return constraint == 0; }
 };
 
@@ -134,6 +141,17 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
   // no perturbation to spare.
   if (ev.task().constraints.half_timestep && both_landed(e, f))
     s.margin = std::min(s.margin, kTimestepAgreement - landing_shift(e.summary, f.summary));
+  // The requirement beyond the task, only where it decides something: on a candidate
+  // that meets the task at both timesteps.
+  if (seed.requirement && s.constraint == 0) {
+    ParameterSet named = ev.parameters();
+    named.set_normalized(x);
+    const SeedRequirement::Verdict verdict = seed.requirement.check(named);
+    s.checked = true;
+    s.held = verdict.holds;
+    s.check_rollouts = verdict.rollouts;
+    if (!verdict.holds) s.constraint += seed.requirement.penalty;
+  }
   double sum = s.constraint;
   int met = 0;
   // Perturbations meet the task as the diversity optimizer will judge them: with the
@@ -151,6 +169,13 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
   s.f = sum / (2 + n);
   if (sum == 0) s.f = -ev.task().seed.robustness * std::min(std::max(s.margin, 0.0), kMarginCap);
   return s;
+}
+
+// ", robust part: holds" or ", robust part: fails" after a candidate judged by the
+// requirement.
+std::string requirement_note(const SeedRequirement& requirement, const Scored& s) {
+  if (!requirement || !s.checked) return "";
+  return ", " + requirement.name + (s.held ? ": holds" : ": fails");
 }
 
 Task halved(const Task& task, const mjModel* m) {
@@ -194,8 +219,10 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   if (task.seed.object.empty() && !by_distance) heights = {-1};
   const int generations = options.generations > 0 ? options.generations : task.seed.generations;
   ThreadPool pool(std::max(1, options.threads));
-  char line[320];
+  char line[512];
 
+  if (options.requirement && !(options.requirement.penalty > 0))
+    throw std::invalid_argument("seed_motion: a requirement needs a penalty > 0");
   if (options.first_stage < 0 || static_cast<size_t>(options.first_stage) >= heights.size()) {
     throw UserError(task.file + ": --from-stage: expected a stage from 0 to " +
                     std::to_string(heights.size() - 1) + " (got " + std::to_string(options.first_stage) + ")");
@@ -218,24 +245,33 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     // raised object, which a mean over perturbations discourages (a neighbourhood that
     // lands short of a box beats one that partly hits its face); the last stage then
     // looks for a robust motion.
+    // The requirement likewise: the intermediate stages' tasks are not the task.
     SeedOptions stage_options = options;
-    if (!last) stage_options.perturbations = 0;
+    if (!last) {
+      stage_options.perturbations = 0;
+      stage_options.requirement = {};
+    }
     const int dim = static_cast<int>(x.size());
     Robustness robust = generation_robustness(task, dim, stage_options, stage, 0);
     // Done with a stage: an intermediate one as soon as a candidate meets its task; the
     // last one when the candidate with the lowest objective meets the task and nothing
     // has improved for kPatience generations (or after the generation budget).
-    Scored best = score(ev, fine, x, *workers[0], *fine_workers[0], robust, options);
+    Scored best = score(ev, fine, x, *workers[0], *fine_workers[0], robust, stage_options);
     Eigen::VectorXd best_x = x;
     bool have_valid = best.meets();
     Scored best_valid = best;
     Eigen::VectorXd best_valid_x = x;
-    result.evaluations += static_cast<long long>(2 + robust.directions.size());
+    result.evaluations += static_cast<long long>(2 + robust.directions.size()) + best.check_rollouts;
+    auto count_check = [&](const Scored& s) {
+      result.requirement_checks += s.checked ? 1 : 0;
+      result.requirement_held += s.checked && s.held ? 1 : 0;
+    };
+    count_check(best);
     if (options.log) {
       std::snprintf(line, sizeof(line),
-                    "stage %zu (%s %.3f m): start f=%.6g C=%.6g margin=%.3f met=%.3f", stage,
+                    "stage %zu (%s %.3f m): start f=%.6g C=%.6g margin=%.3f met=%.3f%s", stage,
                     by_distance ? "landing at" : "height", heights[stage], best.f, best.constraint, best.margin,
-                    best.met);
+                    best.met, requirement_note(stage_options.requirement, best).c_str());
       options.log(line);
     }
     if (last) {
@@ -272,8 +308,15 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       std::vector<Scored> scores(xs.size());
       pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
         const auto w = static_cast<std::size_t>(worker);
-        scores[k] = score(ev, fine, xs[k], *workers[w], *fine_workers[w], robust, options);
+        scores[k] = score(ev, fine, xs[k], *workers[w], *fine_workers[w], robust, stage_options);
       });
+      long long checked = 0, held = 0, check_rollouts = 0;
+      for (const Scored& s : scores) {
+        count_check(s);
+        checked += s.checked ? 1 : 0;
+        held += s.checked && s.held ? 1 : 0;
+        check_rollouts += s.check_rollouts;
+      }
       std::vector<double> f(xs.size());
       bool improved = false;
       for (size_t k = 0; k < xs.size(); ++k) {
@@ -290,7 +333,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
           improved = true;
         }
       }
-      result.evaluations += static_cast<long long>(xs.size() * (2 + robust.directions.size()));
+      result.evaluations += static_cast<long long>(xs.size() * (2 + robust.directions.size())) + check_rollouts;
       es.tell(f);
       since_improvement = improved ? 0 : since_improvement + 1;
       if (options.log) {
@@ -299,11 +342,19 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
                          sorted.end());
         const double median = sorted[sorted.size() / 2];
         const Scored& b = have_valid ? best_valid : best;
+        std::string checks;
+        std::string none_yet = have_valid ? "" : " (none meets the task yet)";
+        if (!have_valid && stage_options.requirement)
+          none_yet = " (none meets the task and the " + stage_options.requirement.name + " yet)";
+        if (stage_options.requirement) {
+          checks = "; " + stage_options.requirement.name + ": " + std::to_string(held) + " of " +
+                   std::to_string(checked) + " that met the task held";
+        }
         std::snprintf(line, sizeof(line),
                       "stage %zu gen %lld: best f=%.6g C=%.6g margin=%.3f met=%.3f%s; lowest f=%.6g "
-                      "median f=%.6g sigma=%.4f",
+                      "median f=%.6g sigma=%.4f%s",
                       stage, es.generation(), b.f, b.constraint, b.margin, b.met,
-                      have_valid ? "" : " (none meets the task yet)", best.f, median, es.sigma());
+                      none_yet.c_str(), best.f, median, es.sigma(), checks.c_str());
         options.log(line);
       }
       if (!last && have_valid) break;
@@ -328,6 +379,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   const Scored final_score = score(ev, fine, x, *worker, *fine_worker, robust, options);
   result.parameters.set_normalized(x);
   result.constraint = final_score.constraint;
+  result.requirement_failed = final_score.checked && !final_score.held;
   result.margin = final_score.margin;
   result.robustness = final_score.met;
   result.fell = final_score.fell;

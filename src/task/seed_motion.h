@@ -36,6 +36,16 @@
 // measure_robustness() reports the fraction of another set of perturbations that meet
 // the task.
 //
+// A requirement beyond the task (SeedOptions::requirement; `diverse seed-motion --robust`
+// sets it to the robustness suite's small part, robust/robustness.h robust_sample_suite()):
+// a candidate of the last stage that meets the task at both timesteps (C = 0) meets it
+// only if it also passes the requirement; one that does not gets the requirement's
+// penalty added to its C, so it ranks below every candidate that meets the task and is
+// never the result written as the task's M0. The requirement is judged only where it
+// decides something, on candidates whose C is otherwise 0, so it costs nothing for the
+// (many) candidates that miss the task anyway. Intermediate continuation stages go
+// without, as they go without perturbations: their tasks are not the task.
+//
 // Deterministic for a given task seed: CMA-ES draws from seeds derived from it, the
 // perturbations likewise, and the generation's samples are evaluated in parallel into
 // fixed slots.
@@ -56,6 +66,20 @@ namespace diverse {
 // The landing spots of an input motion at the task's timestep and at half of it differ by
 // at most kTimestepAgreement (task/constraints.h, with landing_shift()).
 
+// A requirement of the search beyond the task (see above). `check` is called with a
+// candidate's named parameters from the search's threads at once (it must be
+// thread-safe) and returns whether the candidate passes and what that cost in rollouts.
+struct SeedRequirement {
+  struct Verdict {
+    bool holds = true;
+    long long rollouts = 0;
+  };
+  std::function<Verdict(const ParameterSet&)> check;  // empty = no requirement
+  double penalty = 0;  // added to the C of a candidate that meets the task but fails it (> 0)
+  std::string name;    // named in the progress lines ("robust")
+  explicit operator bool() const { return static_cast<bool>(check); }
+};
+
 struct SeedOptions {
   int threads = 1;
   int generations = 0;  // per stage; 0 = the task's seed.generations
@@ -71,6 +95,8 @@ struct SeedOptions {
   // Continuation stages before this one are skipped: the search starts at stage
   // `first_stage` from the starting parameters (a stage file written by `on_stage`).
   int first_stage = 0;
+  // A requirement beyond the task, judged on the last stage's candidates that meet it.
+  SeedRequirement requirement;
   // Called after every generation with a one-line progress report.
   std::function<void(const std::string&)> log;
   // Called at the end of every continuation stage (before the last) with the stage's
@@ -82,11 +108,20 @@ struct SeedOptions {
 
 struct SeedResult {
   ParameterSet parameters;
-  double constraint = 0;  // C of the result on the full task (sum over both timesteps)
+  double constraint = 0;  // C of the result on the full task (sum over both timesteps,
+                          // plus the requirement's penalty when it fails it)
   double margin = 0;      // constraint_margin of the result (m)
   double robustness = 0;  // fraction of the last stage's fixed perturbations met (0 if off)
   bool fell = true;
-  long long evaluations = 0;  // rollouts simulated (2 + perturbations per candidate)
+  // With a requirement: the result meets the task at both timesteps but fails the
+  // requirement (its C is then the requirement's penalty); and, over the last stage's
+  // candidates, how many were judged by it (those that met the task) and how many of
+  // them passed.
+  bool requirement_failed = false;
+  long long requirement_checks = 0;
+  long long requirement_held = 0;
+  // Rollouts simulated: 2 + perturbations per candidate, plus the requirement's.
+  long long evaluations = 0;
   // The last stage's candidate with the lowest objective, whether or not it meets the task
   // (with perturbations, a robust near miss can rank above a fragile motion that meets
   // it): the place to continue a search from.

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # End-to-end test of `diverse gallery` and `diverse export --bvh --gltf` in headless
-# Chromium: makes a short real run (the planar human's high jump) with 12 blends, a run of 3D motions
+# Chromium: makes a short real run (the planar human's high jump) with 12 blends (and a copy
+# of it as a run made before runs ended with the robustness suite), a run of 3D motions
 # (the 3D human pushed three ways under stance control, tests/support/stance_run.h) and a
 # 3D walk that the views follow, their gallery pages, BVH and glTF files, then runs
 # web/test/gallery.e2e.mjs on each (no network: the page must work from disk).
@@ -30,7 +31,7 @@ fi
 
 if [ -n "${E2E_KEEP:-}" ]; then
   work="$E2E_KEEP"
-  rm -rf "$work/run" "$work/run3d" "$work/walk"
+  rm -rf "$work/run" "$work/old" "$work/run3d" "$work/walk"
   mkdir -p "$work"
 else
   work="$(mktemp -d)"
@@ -45,6 +46,19 @@ fi
 "$diverse" gallery "$work/run"
 "$diverse" export "$work/run" --bvh --gltf
 CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/run"
+# The fresh run ended with the robustness suite: its page carries every motion's shares.
+grep -q '"robustness":{"motions":\[{"count":19' "$work/run/gallery.html" ||
+  { echo "FAILED: the fresh run's gallery has no robustness shares"; exit 1; }
+
+# A run made before runs ended with the robustness suite (no robustness.json, no
+# "robustness" in summary.json) still renders, saying the suite was not run.
+rm -rf "$work/old"
+cp -r "$work/run" "$work/old"
+rm -rf "$work/old/robustness.json" "$work/old/gallery.html" "$work/old/blend"
+node -e 'const fs = require("fs"); const f = process.argv[1]; const s = JSON.parse(fs.readFileSync(f, "utf8"));
+         delete s.robustness; fs.writeFileSync(f, JSON.stringify(s, null, 1));' "$work/old/summary.json"
+"$diverse" gallery "$work/old" --no-paths
+CHROMIUM="$chromium" node "$src/web/test/gallery.e2e.mjs" "$work/old"
 
 # 3D: 1.2 s of the 3D human pushed forward, to its left and back-right.
 "$make_stance_run" "$work/run3d" human3d 1.2 0.3,0 0,0.3 -0.2,-0.2

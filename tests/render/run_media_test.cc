@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +25,8 @@
 #include "io/motion_record.h"
 #include "render/gallery.h"
 #include "render/image.h"
+#include "robust/robustness.h"
+#include "core/thread_pool.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -309,6 +312,82 @@ TEST_F(RunMediaTest, GalleryDataHasProgressAndShapes) {
   const nlohmann::json bare = gallery_data(load_run_view(dir), options);
   EXPECT_TRUE(bare["progress"].empty());
   EXPECT_TRUE(bare["shape"].is_null());
+}
+
+// Every motion's shares of the robustness suite: from RUN/robustness.json (as `diverse
+// robustness RUN` writes it), else from summary.json "robustness" (as a run's end writes it);
+// a run with neither (made before the suite) gives null and a note saying the suite was not
+// run; a malformed file is a one-line error naming it.
+TEST_F(RunMediaTest, GalleryDataHasEveryMotionsRobustness) {
+  const fs::path dir = copy("robustness");
+  GalleryOptions options;
+  options.paths = false;
+  const nlohmann::json none = gallery_data(load_run_view(dir), options);
+  EXPECT_TRUE(none["robustness"].is_null());
+  auto says_not_run = [](const nlohmann::json& notes) {
+    return std::any_of(notes.begin(), notes.end(), [](const nlohmann::json& n) {
+      return n.get<std::string>().find("robustness suite not run") != std::string::npos;
+    });
+  };
+  EXPECT_TRUE(says_not_run(none["notes"])) << none["notes"];
+
+  // The suite's file as the command writes it, with one rollout of each kind per motion.
+  RobustnessSuite suite;
+  suite.parameter_samples = 1;
+  suite.push_samples = 1;
+  suite.friction_factors = {0.6};
+  const TaskEvaluator evaluator(load_task(kTaskFile));
+  const RunView run = load_run_view(dir);
+  std::vector<MotionUnderTest> motions;
+  for (const RunMotion& m : run.motions)
+    motions.push_back({m.label, m.index, evaluator.load_parameters((dir / "motions" / ("m" + std::to_string(m.index) + ".json")).string())});
+  ThreadPool pool(2);
+  const nlohmann::json file = robustness_json(evaluator, motions, suite, pool);
+  write_json_atomic(dir / "robustness.json", file);
+  const nlohmann::json data = gallery_data(load_run_view(dir), options);
+  EXPECT_FALSE(says_not_run(data["notes"])) << data["notes"];
+  ASSERT_TRUE(data["robustness"].is_object());
+  EXPECT_EQ(data["robustness"]["source"], "robustness.json");
+  EXPECT_EQ(data["robustness"]["suite"], file["suite"]);
+  ASSERT_EQ(data["robustness"]["motions"].size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const nlohmann::json& shown = data["robustness"]["motions"][i];
+    const nlohmann::json& measured = file["motions"][i];
+    EXPECT_EQ(shown["held"], measured["held"]);
+    EXPECT_EQ(shown["count"], 4);
+    EXPECT_EQ(shown["share"], measured["share"]);
+    for (const char* kind : {"parameters", "pushes", "friction", "half_timestep"}) {
+      EXPECT_EQ(shown["kinds"][kind]["held"], measured["kinds"][kind]["held"]) << kind;
+      EXPECT_EQ(shown["kinds"][kind]["count"], 1) << kind;
+    }
+  }
+
+  // Without the file, summary.json's shares (a run's end writes both).
+  nlohmann::json summary = read_json(dir / "summary.json");
+  summary["robustness"] = {{"suite", file["suite"]}, {"motions", nlohmann::json::array()}};
+  for (const nlohmann::json& m : file["motions"]) {
+    nlohmann::json kinds = nlohmann::json::object();
+    for (const auto& [key, kind] : m["kinds"].items()) kinds[key] = {{"held", kind["held"]}, {"count", kind["count"]}};
+    summary["robustness"]["motions"].push_back(
+        {{"label", m["label"]}, {"held", m["held"]}, {"count", m["count"]}, {"share", m["share"]}, {"kinds", kinds}});
+  }
+  write_json_atomic(dir / "summary.json", summary);
+  fs::remove(dir / "robustness.json");
+  const nlohmann::json from_summary = gallery_data(load_run_view(dir), options);
+  EXPECT_EQ(from_summary["robustness"]["source"], "summary.json");
+  EXPECT_EQ(from_summary["robustness"]["motions"], data["robustness"]["motions"]);
+
+  // A broken file is refused in one line naming it and the field.
+  nlohmann::json broken = file;
+  broken["motions"][1]["kinds"]["pushes"]["held"] = -1;
+  write_json_atomic(dir / "robustness.json", broken);
+  try {
+    gallery_data(load_run_view(dir), options);
+    FAIL() << "expected a UserError";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "robustness.json").string() +
+                                         ": motions[].kinds.pushes.held: expected a count (an integer >= 0)");
+  }
 }
 
 TEST(GalleryHtml, DataReplacesTheDataMarkerAndCannotEndTheScript) {

@@ -1,15 +1,22 @@
 // `diverse seed-motion` keeps the task's m0 file for motions that meet the task: a search
 // that falls short writes its best attempt beside it and says how to continue. With
 // --robustness-check it measures a motion and its neighbourhood instead of searching.
+// With --robust the m0 file only ever receives a motion that also holds the robustness
+// suite's small part, and --robustness-check --robust says whether a motion holds it.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
+#include <regex>
 #include <string>
 
+#include "eval/motion_problem.h"
 #include "io/files.h"
+#include "robust/robustness.h"
 #include "support/cli.h"
 #include "support/scratch.h"
+#include "task/evaluate.h"
+#include "task/task.h"
 
 namespace diverse {
 namespace {
@@ -108,6 +115,118 @@ TEST(SeedMotionCli, RobustnessCheckOfAMissingFileSaysWhichFile) {
   EXPECT_NE(r.output.find("diverse: error: /nonexistent/m0.json: cannot read the parameter file"),
             std::string::npos)
       << r.output;
+}
+
+// tasks/NAME.toml copied into DIR with its paths made absolute, its m0 file in DIR (so a
+// search never writes the committed one) and `seed_extra` added to its [seed] table.
+fs::path copy_task(const fs::path& dir, const std::string& name, const std::string& seed_extra) {
+  const std::string source = DIVERSE_SOURCE_DIR;
+  std::string t = read_file(source + "/tasks/" + name + ".toml");
+  t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + source + "/assets/");
+  t = std::regex_replace(t, std::regex("\nm0 = \"[^\"]*\""), "\nm0 = \"" + (dir / (name + ".m0.json")).string() + "\"");
+  t = std::regex_replace(t, std::regex("\nbase = \""), "\nbase = \"" + source + "/tasks/");
+  t = std::regex_replace(t, std::regex("\n\\[seed\\]\n"), "\n[seed]\n" + seed_extra);
+  const fs::path file = dir / (name + ".toml");
+  write_file_atomic(file, t);
+  return file;
+}
+
+// Whether the motion in `file` meets the task at its timestep and at half of it, and holds
+// the robustness suite's part as `diverse run --robust` judges it.
+void expect_meets_the_task_and_holds(const TaskEvaluator& ev, const fs::path& file) {
+  const ParameterSet p = ev.load_parameters(file.string());
+  EvaluationOptions coarse, fine;
+  coarse.half_timestep_check = true;
+  fine.timestep_scale = 0.5;
+  EXPECT_EQ(ev.evaluate_named(p, coarse).constraint, 0.0) << file;
+  EXPECT_EQ(ev.evaluate_named(p, fine).constraint, 0.0) << file;
+  EXPECT_TRUE(check_suite(ev, p, robust_sample_suite()).holds) << file;
+}
+
+// A short --robust search from the robot's input walk, which holds the suite's part: what
+// it writes as the m0 meets the task at both timesteps and holds the part, and says how it
+// was found.
+TEST(SeedMotionCli, RobustSearchWritesOnlyAMotionThatHoldsTheSuitesPart) {
+  const fs::path dir = test_files::scratch_dir("seed_motion_cli_test_robust");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path task = copy_task(dir, "robot_silly_walk", "popsize = 4\n");
+  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tasks/robot_silly_walk.m0.json";
+  const auto r = cli_test::run_cli("seed-motion " + task.string() + " --start " + start +
+                                   " --generations 1 --sigma 0.005 --threads 2 --robust");
+  const fs::path m0 = dir / "robot_silly_walk.m0.json";
+  const TaskEvaluator ev(load_task(task.string()));
+  ASSERT_TRUE(fs::exists(m0)) << "the input walk holds the suite's part, so the search has one to write: " << r.output;
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("robust=holds"), std::string::npos) << r.output;
+  const nlohmann::json j = read_json(m0);
+  EXPECT_EQ(j["constraint"].get<double>(), 0.0);
+  EXPECT_NE(j["found_by"].get<std::string>().find(" --robust ("), std::string::npos) << j["found_by"];
+  expect_meets_the_task_and_holds(ev, m0);
+}
+
+// A candidate that meets the task but fails the suite's part is never written as the m0:
+// jump_forward's input motion (which does not hold the part) and candidates a millionth of
+// the ranges around it go to the partial file, with the penalty of a miss, and the hint to
+// go on keeps --robust. Without --robust the same search writes the m0.
+TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
+  const fs::path dir = test_files::scratch_dir("seed_motion_cli_test_fails_part");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path task = copy_task(dir, "jump_forward", "popsize = 6\n");
+  const TaskEvaluator ev(load_task(task.string()));
+  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_forward.m0.json";
+  if (check_suite(ev, ev.load_parameters(start), robust_sample_suite()).holds)
+    GTEST_SKIP() << "jump_forward's input motion holds the suite's part now: this test needs one that does not";
+  const std::string args = "seed-motion " + task.string() + " --start " + start + " --generations 1 --sigma 1e-6 --threads 2";
+  const fs::path m0 = dir / "jump_forward.m0.json", partial = dir / "jump_forward.partial.json";
+
+  const auto robust = cli_test::run_cli(args + " --robust");
+  EXPECT_EQ(robust.status, 2) << robust.output;
+  if (fs::exists(m0)) {
+    ADD_FAILURE() << "a candidate was written as the m0: " << robust.output;
+    expect_meets_the_task_and_holds(ev, m0);
+  }
+  ASSERT_TRUE(fs::exists(partial)) << robust.output;
+  const nlohmann::json j = read_json(partial);
+  EXPECT_EQ(j["constraint"].get<double>(), robust_failure_penalty(ev.task())) << robust.output;
+  EXPECT_NE(j["found_by"].get<std::string>().find(" --robust ("), std::string::npos) << j["found_by"];
+  EXPECT_NE(robust.output.find("robust=fails (0 of "),
+            std::string::npos) << robust.output;
+  EXPECT_NE(robust.output.find("no motion meeting the task and holding the robustness suite's part (--robust) was found"),
+            std::string::npos) << robust.output;
+  EXPECT_NE(robust.output.find("--start " + partial.string() + " --robust`"), std::string::npos) << robust.output;
+
+  fs::remove(partial);
+  const auto plain = cli_test::run_cli(args);
+  EXPECT_EQ(plain.status, 0) << plain.output;
+  ASSERT_TRUE(fs::exists(m0)) << plain.output;
+  EXPECT_EQ(read_json(m0)["constraint"].get<double>(), 0.0);
+  EXPECT_EQ(read_json(m0)["found_by"].get<std::string>().find("--robust"), std::string::npos);
+}
+
+// --robustness-check --robust says whether the motion holds the suite's part, as the search
+// and `diverse run --robust` judge it, with each kind's count.
+TEST(SeedMotionCli, RobustnessCheckWithRobustSaysWhetherTheMotionHoldsTheSuitesPart) {
+  const Task task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const bool holds = check_suite(ev, m0, robust_sample_suite()).holds;
+  ThreadPool pool(1);
+  const MotionRobustness all =
+      run_robustness_suite(ev, {MotionUnderTest{"M0", 0, m0}}, robust_sample_suite(), pool).front();
+  const auto r = cli_test::run_cli("seed-motion jump_high --robustness-check --robust --check-sigmas 1e-6 --check-samples 1");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string expected =
+      "the robustness suite's part (--robust: 2 parameter perturbations at sigma 0.02 and 2 pushes of 0.3 m/s in the "
+      "landing): " + std::string(holds ? "holds" : "does not hold") + ", " + std::to_string(all.held()) + " of 4 perturbed "
+      "rollouts meet the task (params " + std::to_string(all.held(PerturbationKind::kParameters)) + "/2, pushes " +
+      std::to_string(all.held(PerturbationKind::kPush)) + "/2; 3 needed)";
+  EXPECT_NE(r.output.find(expected), std::string::npos) << expected << "\n" << r.output;
+  EXPECT_EQ(holds, all.held() >= 3);
+  // Without --robust, no such line.
+  const auto plain = cli_test::run_cli("seed-motion jump_high --robustness-check --check-sigmas 1e-6 --check-samples 1");
+  EXPECT_EQ(plain.output.find("suite's part"), std::string::npos) << plain.output;
 }
 
 }  // namespace

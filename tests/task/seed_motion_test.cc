@@ -1,14 +1,19 @@
 // Searching for input motions: the perturbations the robustness term and the robustness
 // check use stay in the normalized box, follow their seed alone and have the asked-for
 // spread; the robustness check tells a motion's neighbourhood apart from random
-// controllers; the search's own requirement on the flight rotation is enforced; and the
-// robustness term keeps the search independent of the number of threads.
+// controllers; the search's own requirement on the flight rotation is enforced; the
+// robustness term keeps the search independent of the number of threads; and a
+// requirement beyond the task (`--robust`) is judged only on candidates that meet the
+// task, a candidate that fails it never being the result.
 #include "task/seed_motion.h"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "task/evaluate.h"
 
@@ -153,6 +158,86 @@ TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
   const double d = check.landing_shift - kTimestepAgreement;
   EXPECT_GT(r.constraint, 0.0);  // M0's K_c d^2 or a candidate's smaller one, never 0
   EXPECT_LE(r.constraint, task.constraints.weight * d * d + 1e-12);
+}
+
+// A requirement beyond the task is judged only on candidates that meet the task at both
+// timesteps, and one it rejects gets its penalty: with a requirement that rejects
+// everything, no candidate near jump_high's input motion (which meets the task) is
+// accepted. (A millionth of the ranges from it, some candidates already miss the task by
+// a hair: it lands 2.8 cm apart at the two timesteps, 3 cm allowed.)
+TEST(SeedMotion, ARequirementIsJudgedOnlyOnCandidatesThatMeetTheTask) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  std::mutex mutex;
+  std::vector<ParameterSet> judged;
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.sigma = 1e-6;  // candidates barely different from M0: they meet the task too
+  options.requirement.name = "never";
+  options.requirement.penalty = 25;
+  options.requirement.check = [&](const ParameterSet& p) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    judged.push_back(p);
+    return SeedRequirement::Verdict{false, 3};
+  };
+  const SeedResult r = seed_motion(task, m0, options);
+  EXPECT_GT(r.constraint, 0.0);  // nothing was accepted
+  EXPECT_EQ(r.requirement_held, 0);
+  // The start (which meets the task) and most candidates were judged, and the result
+  // once more when it met the task: then its C is the penalty.
+  EXPECT_GT(r.requirement_checks, task.seed.popsize / 2);
+  EXPECT_EQ(static_cast<long long>(judged.size()), r.requirement_checks + (r.requirement_failed ? 1 : 0));
+  if (r.requirement_failed) {
+    EXPECT_EQ(r.constraint, 25.0);
+  }
+  EXPECT_EQ(r.evaluations, 2 * (1 + task.seed.popsize) + 3 * r.requirement_checks);
+  // Each judged candidate met the task at the task's timestep and at half of it.
+  EvaluationOptions fine;
+  fine.timestep_scale = 0.5;
+  for (const ParameterSet& p : judged) {
+    EXPECT_EQ(ev.evaluate_named(p).constraint, 0.0);
+    EXPECT_EQ(ev.evaluate_named(p, fine).constraint, 0.0);
+  }
+
+  // A candidate that misses the task is not judged: far from M0 (sigma 0.3), most miss.
+  judged.clear();
+  options.sigma = 0.3;
+  const SeedResult far = seed_motion(task, m0, options);
+  EXPECT_EQ(static_cast<long long>(judged.size()), far.requirement_checks + (far.requirement_failed ? 1 : 0));
+  EXPECT_LT(far.requirement_checks, 1 + task.seed.popsize);
+  EXPECT_GT(far.constraint, 0.0);
+}
+
+// A requirement every candidate passes changes nothing but the count of rollouts.
+TEST(SeedMotion, ARequirementEveryCandidatePassesChangesNothing) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.sigma = 0.003;
+  const SeedResult plain = seed_motion(task, m0, options);
+  std::atomic<int> calls{0};
+  options.requirement.name = "always";
+  options.requirement.penalty = 25;
+  options.requirement.check = [&](const ParameterSet&) {
+    ++calls;
+    return SeedRequirement::Verdict{true, 1};
+  };
+  const SeedResult with = seed_motion(task, m0, options);
+  EXPECT_EQ(with.parameters.values(), plain.parameters.values());
+  EXPECT_EQ(with.constraint, plain.constraint);
+  EXPECT_FALSE(with.requirement_failed);
+  EXPECT_EQ(with.requirement_held, with.requirement_checks);
+  EXPECT_GT(with.requirement_checks, 0);
+  EXPECT_EQ(with.evaluations, plain.evaluations + with.requirement_checks);
+  EXPECT_EQ(calls.load(), with.requirement_checks + (plain.constraint == 0 ? 1 : 0));
+  // A requirement without a penalty would let a failure meet the task: refused.
+  options.requirement.penalty = 0;
+  EXPECT_THROW(seed_motion(task, m0, options), std::invalid_argument);
 }
 
 }  // namespace

@@ -33,6 +33,44 @@ const el = (tag, attrs = {}, text) => {
   return e;
 };
 
+// ---------------------------------------------------------------- robustness
+
+// The robustness suite's kinds of perturbed rollouts, as robustness.json names them and as
+// the page shows them (as `diverse robustness` does).
+const ROBUST_KINDS = [['parameters', 'params'], ['pushes', 'pushes'], ['friction', 'friction'], ['half_timestep', 'half-step']];
+// A whole percentage as C's printf("%.0f") gives it (ties to even), so the page says what
+// `diverse robustness` and `diverse report` say.
+function percent(held, count) {
+  if (!(count > 0)) return 0;
+  const x = (100 * held) / count;
+  const r = Math.round(x);
+  return r - x === 0.5 && r % 2 !== 0 ? r - 1 : r;
+}
+// One motion's shares (data.robustness.motions[i]) as "holds 5 of 19 (26 %)" and "params
+// 0/8, pushes 4/8, friction 0/2, half-step 1/1"; null when the suite was not run on it.
+function robustnessOf(i) {
+  const r = data.robustness?.motions?.[i];
+  if (!r) return null;
+  const kinds = ROBUST_KINDS.filter(([k]) => r.kinds?.[k]?.count > 0)
+    .map(([k, name]) => `${name} ${r.kinds[k].held}/${r.kinds[k].count}`);
+  return {
+    total: `holds ${r.held} of ${r.count} (${percent(r.held, r.count)} %)`,
+    kinds: kinds.join(', '),
+    kindList: kinds,
+    percent: percent(r.held, r.count),
+    share: r.share,
+  };
+}
+// What the suite is, for the page's help: "8 parameter perturbations at sigma 0.02, ...".
+function suiteText(suite) {
+  const parts = [];
+  if (suite.parameter_samples) parts.push(`${suite.parameter_samples} perturbations of the parameters at sigma ${suite.sigma}`);
+  if (suite.push_samples) parts.push(`${suite.push_samples} pushes of ${suite.push_speed} m/s in a ground phase`);
+  if ((suite.friction_factors || []).length) parts.push(`friction ${suite.friction_factors.map((f) => `x${f}`).join(' and ')}`);
+  if (suite.half_timestep) parts.push('half the timestep');
+  return parts.join(', ');
+}
+
 // ---------------------------------------------------------------- header
 
 function fillHeader() {
@@ -58,6 +96,16 @@ function fillHeader() {
     $('facts').append(d);
   }
   for (const note of data.notes || []) $('notes').append(el('li', {}, note));
+  const help = $('robustness-help');
+  if (data.robustness) {
+    const suite = data.robustness.suite || {};
+    help.textContent = 'Under each motion, how many of the robustness suite\'s perturbed rollouts still meet the task' +
+      (suiteText(suite) ? ` (${suiteText(suite)}${suite.seed !== undefined ? `; seed ${suite.seed}` : ''})` : '') +
+      `, from ${data.robustness.source}: a motion that holds few of them sits on a knife edge.`;
+  } else {
+    help.replaceChildren('The robustness suite was not run on this run\'s motions (a run made before every run ended ' +
+      'with it): ', el('code', {}, 'diverse robustness RUN'), ' runs it; then make the gallery again.');
+  }
 }
 
 // ---------------------------------------------------------------- distance table
@@ -78,8 +126,10 @@ function fillDistances() {
     const head = el('tr');
     const bounds = (data.run || {}).bounds || {};
     const hasEffort = data.motions.some((m) => typeof m.effort_ratio === 'number');
+    const hasRobustness = Boolean(data.robustness);
     head.append(el('th', {}, ''), el('th', {}, 'C'));
     if (hasEffort) head.append(el('th', { title: 'control effort relative to M0\'s' }, 'effort'));
+    if (hasRobustness) head.append(el('th', { title: 'the share of the robustness suite\'s perturbed rollouts that still meet the task' }, 'holds'));
     for (const l of labels) head.append(el('th', {}, l));
     table.append(head);
     const d = dist[current] || [];
@@ -96,6 +146,11 @@ function fillDistances() {
           title: `effort ${fmt(m.effort)} N²m²s, positive work ${fmt(m.positive_work)} J` +
             (bounds.effort !== undefined ? `; bound ${fmt(bounds.effort)}x M0's` : ''),
         }, `${fmt(m.effort_ratio)}x`));
+      }
+      if (hasRobustness) {
+        const r = robustnessOf(i);
+        row.append(r ? el('td', { class: 'robust', title: `${r.total}: ${r.kinds}` }, `${r.percent} %`)
+          : el('td', { class: 'robust self', title: 'the robustness suite was not run on this motion' }, 'n/a'));
       }
       const others = (d[i] || []).filter((_, j) => j !== i);
       const min = Math.min(...others);
@@ -116,7 +171,8 @@ function fillDistances() {
       '. In bold, each motion\'s nearest neighbour (dmin). C is the constraint penalty: 0 when the task is met' +
       ((data.run || {}).bounds && Object.keys(data.run.bounds).length ? ' and every bound is kept' : '') + '.' +
       (hasEffort ? ' Effort: the time integral of the squared joint torques, as a multiple of M0\'s' +
-        (bounds.effort !== undefined ? ' (red: over the bound)' : '') + '.' : '');
+        (bounds.effort !== undefined ? ' (red: over the bound)' : '') + '.' : '') +
+      (hasRobustness ? ' Holds: the share of the robustness suite\'s perturbed rollouts that still meet the task.' : '');
     for (const b of $('metric-tabs').children) b.setAttribute('aria-selected', String(b.dataset.metric === current));
   };
   for (const m of metrics) {
@@ -558,6 +614,12 @@ function updateTileText(t) {
   t.status.textContent = s.text;
   t.status.className = `status ${s.ok ? 'ok' : 'bad'}`;
   t.dom.classList.toggle('infeasible', !s.ok);
+  // The suite measured the motion the run returned, not the path's other points.
+  if (t.robustLabel) {
+    const other = Boolean(point && !point.result);
+    t.robustLabel.textContent = other ? `robustness of ${t.motion.label}` : 'robustness';
+    t.robust.classList.toggle('other', other);
+  }
   if (!point) return;
   const pct = Math.round(point.fraction * 100);
   const where = point.result ? 'the result' : point.generation === 0 ? 'the start (M0)' : `after generation ${point.generation}`;
@@ -572,6 +634,22 @@ for (const t of tiles) {
   const head = el('div', { class: 'tile-head' });
   t.status = el('span', { class: 'status' });
   head.append(el('span', { class: 'label' }, t.motion.label), t.status);
+  if (!t.blend) {
+    // Its shares of the robustness suite, or that the suite was not run (in the foot).
+    const r = robustnessOf(t.index);
+    t.robust = el('div', { class: `robustness${r ? '' : ' not-run'}` });
+    t.robustLabel = el('span', { class: 'robust-label' }, 'robustness');
+    t.robust.append(t.robustLabel, ' ');
+    if (r) {
+      t.robust.append(el('span', { class: `robust-total ${r.share >= 0.75 ? 'ok' : ''}` }, r.total), ': ');
+      // Each kind's count kept on one line.
+      r.kindList.forEach((k, j) => t.robust.append(j ? ', ' : '', el('span', { class: 'robust-kind' }, k)));
+      t.robust.title = 'Perturbed rollouts of this motion that still meet the task (the robustness suite, docs/robustness.md)';
+    } else {
+      t.robust.append('suite not run');
+      t.robust.title = 'No robustness data for this motion: `diverse robustness RUN` measures it';
+    }
+  }
   const viewport = el('div', { class: 'viewport', 'aria-label': `${t.motion.label} in 3D` });
   const foot = el('div', { class: 'tile-foot' });
   if (t.blend) {
@@ -606,6 +684,9 @@ for (const t of tiles) {
       t.index === 0 ? 'M0, the input motion: every variation starts here and is pushed away from it.'
                     : 'No optimization path in this gallery.'));
   }
+  // Under the view, so every tile's view starts at the same height (the blend tile has
+  // no such line).
+  if (t.robust) foot.prepend(t.robust);
   dom.append(head, viewport, foot);
   $('tiles').append(dom);
   Object.assign(t, { dom, viewport });

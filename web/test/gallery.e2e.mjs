@@ -20,7 +20,9 @@
 // for every blend, its own weights on the sliders bring up the blend nearest to them (as
 // the test computes it), marked as meeting the task or not as its constraint says; two
 // corners of the simplex show different pictures. Writes RUN_DIR/gallery-screenshot.png, plots-screenshot.png and
-// gltf-screenshot.png. Chromium: $CHROMIUM or /usr/bin/chromium.
+// gltf-screenshot.png. Every motion shows its shares of the robustness suite (robustness.json
+// or summary.json), or, for a run without them, that the suite was not run. Chromium:
+// $CHROMIUM or /usr/bin/chromium.
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -324,6 +326,45 @@ try {
     check((bounds.effort === undefined || shown.facts.includes('effort bound')) &&
       (bounds.distance === undefined || shown.facts.includes('distance bound')),
       'the run\'s bounds are among its facts', shown.facts);
+  }
+
+  // ---------------------------------------------------------------- robustness
+
+  // Every motion's shares of the robustness suite beside its other figures, as the run
+  // wrote them (RUN/robustness.json, else summary.json "robustness"); a run without them
+  // (made before every run ended with the suite) says on every motion that it was not run.
+  const robustFile = join(runDir, 'robustness.json');
+  const summary = JSON.parse(readFileSync(join(runDir, 'summary.json'), 'utf8'));
+  const measured = existsSync(robustFile) ? JSON.parse(readFileSync(robustFile, 'utf8')) : summary.robustness;
+  const robustShown = await page.evaluate(() => ({
+    tiles: [...document.querySelectorAll('.tile:not(.blend)')].map((t) => t.querySelector('.robustness')?.textContent ?? ''),
+    column: [...document.querySelectorAll('#distances td.robust')].map((t) => t.textContent),
+    notes: document.getElementById('notes').textContent,
+    help: document.getElementById('robustness-help').textContent,
+  }));
+  if (measured) {
+    // printf's %.0f: ties to even.
+    const pct = (h, c) => { const x = (100 * h) / c; const r = Math.round(x); return r - x === 0.5 && r % 2 ? r - 1 : r; };
+    const names = [['parameters', 'params'], ['pushes', 'pushes'], ['friction', 'friction'], ['half_timestep', 'half-step']];
+    const expected = data.motions.map((m) => {
+      const r = measured.motions.find((x) => x.label === m.label);
+      if (!r) return null;
+      const kinds = names.filter(([k]) => r.kinds[k].count > 0).map(([k, name]) => `${name} ${r.kinds[k].held}/${r.kinds[k].count}`);
+      return { text: `holds ${r.held} of ${r.count} (${pct(r.held, r.count)} %): ${kinds.join(', ')}`, cell: `${pct(r.held, r.count)} %` };
+    });
+    check(expected.every((e, i) => e && robustShown.tiles[i].includes(e.text)),
+      'every motion shows its shares of the robustness suite, over all and by kind',
+      JSON.stringify({ shown: robustShown.tiles, expected: expected.map((e) => e?.text) }));
+    check(robustShown.column.length === data.motions.length && expected.every((e, i) => robustShown.column[i] === e.cell),
+      'the distance table shows every motion\'s share of the suite', JSON.stringify(robustShown.column));
+    check(!robustShown.notes.includes('robustness suite not run') && robustShown.help.includes('robustness suite'),
+      'the page says what the suite is', robustShown.help);
+  } else {
+    check(robustShown.tiles.length === data.motions.length && robustShown.tiles.every((t) => t.includes('suite not run')),
+      'a run without robustness data says on every motion that the suite was not run', JSON.stringify(robustShown.tiles));
+    check(robustShown.column.length === 0, 'and has no robustness column in the distance table');
+    check(robustShown.notes.includes('robustness suite not run') && robustShown.help.includes('was not run'),
+      'and says how to run it', `${robustShown.notes} | ${robustShown.help}`);
   }
 
   await page.locator('#time').fill('500');
