@@ -873,7 +873,9 @@ function draw() {
 }
 
 function frame(now) {
-  const dt = Math.min((now - last) / 1000, 0.1);
+  // A frame's time stamp is when the frame began, which can come before `last` (play
+  // pressed, or the speed changed, within the frame): never a step backwards.
+  const dt = Math.max(0, Math.min((now - last) / 1000, 0.1));
   last = now;
   if (playing) {
     const T = duration();

@@ -144,6 +144,25 @@ try {
   const [shown, total] = (clock.match(/^(\d+\.\d\d) s \/ (\d+\.\d\d) s$/) || []).slice(1).map(Number);
   check(total > 0 && Math.abs(shown - 0.45 * total) <= 0.011, 'the clock shows the scrubbed time (45 %)', clock);
 
+  // An animation frame's time stamp is when the frame began, which can come before the
+  // moment play was pressed: the clock must not run backwards (it did, to a negative time).
+  const early = await page.evaluate(async () => {
+    const scrubber = document.getElementById('time');
+    scrubber.value = '0';
+    scrubber.dispatchEvent(new Event('input'));
+    const real = performance.now.bind(performance);
+    performance.now = () => real() + 1000;  // play pressed "1 s after" the next frames begin
+    document.getElementById('play').click();
+    performance.now = real;
+    await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    const text = document.getElementById('clock').textContent;
+    document.getElementById('play').click();
+    return text;
+  });
+  check(/^\d/.test(early), 'the clock never runs backwards', early);
+  await page.locator('#time').fill('450');
+  await settle();
+
   // A path slider: from the result (100 %) to a point whose motion differs from it.
   const v = data.paths.findIndex((p) => p && p.points.length > 1);
   if (data.paths.length > 0) check(v > 0, 'the page has an optimization path with several points');
