@@ -166,20 +166,20 @@ TEST(SeedMotionCli, RobustSearchWritesOnlyAMotionThatHoldsTheSuitesPart) {
 }
 
 // A candidate that meets the task but fails the suite's part is never written as the m0:
-// jump_forward's input motion (which does not hold the part) and candidates a millionth of
-// the ranges around it go to the partial file, with the penalty of a miss, and the hint to
-// go on keeps --robust. Without --robust the same search writes the m0.
+// jump_high's input motion (which does not hold the part) and candidates a millionth of
+// the ranges around it, some of which meet the task, go to the partial file, and the hint
+// to go on keeps --robust. Without --robust the same search writes the m0.
 TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
   const fs::path dir = test_files::scratch_dir("seed_motion_cli_test_fails_part");
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const fs::path task = copy_task(dir, "jump_forward", "popsize = 6\n");
+  const fs::path task = copy_task(dir, "jump_high", "popsize = 6\n");
   const TaskEvaluator ev(load_task(task.string()));
-  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_forward.m0.json";
-  if (check_suite(ev, ev.load_parameters(start), robust_sample_suite()).holds)
-    GTEST_SKIP() << "jump_forward's input motion holds the suite's part now: this test needs one that does not";
+  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.m0.json";
+  ASSERT_FALSE(check_suite(ev, ev.load_parameters(start), robust_sample_suite()).holds)
+      << "jump_high's input motion holds the suite's part now: this test needs one that does not";
   const std::string args = "seed-motion " + task.string() + " --start " + start + " --generations 1 --sigma 1e-6 --threads 2";
-  const fs::path m0 = dir / "jump_forward.m0.json", partial = dir / "jump_forward.partial.json";
+  const fs::path m0 = dir / "jump_high.m0.json", partial = dir / "jump_high.partial.json";
 
   const auto robust = cli_test::run_cli(args + " --robust");
   EXPECT_EQ(robust.status, 2) << robust.output;
@@ -189,12 +189,15 @@ TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
   }
   ASSERT_TRUE(fs::exists(partial)) << robust.output;
   const nlohmann::json j = read_json(partial);
-  EXPECT_EQ(j["constraint"].get<double>(), robust_failure_penalty(ev.task())) << robust.output;
+  // The best candidate is one that met the task and missed the part (C = the penalty) or
+  // a near miss of the task that ranks above it (C below the penalty); never C = 0.
+  const double c = j["constraint"].get<double>();
+  EXPECT_GT(c, 0.0) << robust.output;
+  EXPECT_LE(c, robust_failure_penalty(ev.task())) << robust.output;
   EXPECT_NE(j["found_by"].get<std::string>().find(" --robust ("), std::string::npos) << j["found_by"];
-  EXPECT_NE(robust.output.find("robust=fails (0 of "),
-            std::string::npos) << robust.output;
-  EXPECT_NE(robust.output.find("no motion meeting the task and holding the robustness suite's part (--robust) was found"),
-            std::string::npos) << robust.output;
+  EXPECT_NE(robust.output.find("robust part: 0 of "), std::string::npos) << robust.output;
+  EXPECT_EQ(robust.output.find("robust part: 0 of 0 "), std::string::npos) << "some candidate met the task: " << robust.output;
+  EXPECT_NE(robust.output.find("no motion meeting the task"), std::string::npos) << robust.output;
   EXPECT_NE(robust.output.find("--start " + partial.string() + " --robust`"), std::string::npos) << robust.output;
 
   fs::remove(partial);
