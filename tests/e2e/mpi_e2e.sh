@@ -83,9 +83,12 @@ sim=("${args[@]}" --generations 2 --strategy simultaneous)
   { diff <(summary "$work/sim1") <(summary "$work/sim2") | head -20; fail "simultaneous, 2 ranks: summary.json differs from one process's"; }
 echo "ok: simultaneous, 2 ranks = 1 process"
 
-# The uninterrupted run the interrupted ones must end with (6 generations, a checkpoint
-# after every generation).
-long=("${args[@]}" --generations 6 --checkpoint-seconds 0)
+# The uninterrupted run the interrupted ones must end with (30 generations, a checkpoint
+# after every generation). Each interruption comes at generation 2: the rest must take
+# far longer than the script takes to act, or the run ends first (at 6 generations a
+# run on an idle machine could finish before the stop, and rank 0 then waited in
+# MPI_Finalize for the stopped worker).
+long=("${args[@]}" --generations 30 --checkpoint-seconds 0)
 "$diverse" run "$task" "${long[@]}" --out "$work/reference" || fail "diverse run (reference)"
 reference="$(summary "$work/reference")"
 
@@ -143,6 +146,12 @@ while kill -0 "$mpid" 2>/dev/null && [ $((SECONDS - stopped_at)) -lt 120 ]; do s
 if kill -0 "$mpid" 2>/dev/null; then
   cat "$work/d.txt"
   ps -o pid,stat,etime,args --ppid "$mpid" || true
+  echo "checkpoint generation: $(generation "$work/d"); summary.json: $([ -f "$work/d/summary.json" ] && echo written || echo none)"
+  # Where each rank is (gdb, where the machine lets it attach).
+  for p in $(pgrep -P "$mpid"); do
+    echo "== pid $p"
+    timeout 30 gdb -p "$p" -batch -ex "thread apply all bt 12" 2>/dev/null | grep -E "^#|^Thread" | head -80 || true
+  done
   kill -CONT "$worker"; kill -9 "$worker" "$mpid"
   fail "4: mpirun still runs 120 s after a worker was stopped (rank timeout 2 s)"
 fi
