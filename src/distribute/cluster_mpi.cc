@@ -58,6 +58,32 @@ void send(const std::string& bytes, int to, int tag) {
         "send");
 }
 
+// Sends without blocking for longer than `timeout_seconds`: a plain MPI_Send to a rank
+// that has stopped taking messages can wait forever (Open MPI's shared-memory transport
+// waits for the receiver to hand back its buffers). Returns false if the send did not
+// complete in that time; the message then stays in `abandoned`, which MPI may still read,
+// and the caller gives the rank up.
+bool send_within(const std::string& bytes, int to, int tag, double timeout_seconds,
+                 std::vector<std::string>& abandoned) {
+  MPI_Request request = MPI_REQUEST_NULL;
+  check(MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, to, tag, MPI_COMM_WORLD, &request),
+        "send");
+  Backoff backoff;
+  const auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    int done = 0;
+    check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "send");
+    if (done) return true;
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout_seconds) {
+      abandoned.push_back(bytes);
+      // The request is left to MPI: the process stops using MPI (no MPI_Finalize) once a
+      // rank is lost.
+      return false;
+    }
+    backoff.sleep();
+  }
+}
+
 // Waits (polling) for a message from `from` (MPI_ANY_SOURCE allowed) and receives it.
 // With `timeout_seconds` > 0, returns false if none came in that time.
 bool receive(int from, int* tag, int* source, std::string* out, double timeout_seconds = 0) {
@@ -167,6 +193,7 @@ struct Cluster::Impl {
   Traffic traffic;
   double rank_timeout = kDefaultRankTimeoutSeconds;  // rank 0: see set_rank_timeout
   bool lost = false;                    // rank 0: a worker stopped answering (no MPI_Finalize)
+  std::vector<std::string> abandoned;   // rank 0: messages of sends given up (send_within)
 
   std::string who(int r) const {
     return "rank " + std::to_string(r) + " (" + (r < static_cast<int>(hosts.size()) && !hosts[static_cast<std::size_t>(r)].empty() ? hosts[static_cast<std::size_t>(r)] : std::string("?")) + ")";
@@ -251,7 +278,8 @@ class ClusterEvaluator : public BatchEvaluator {
           const std::string task = with_header(Header{batch, k, 0}, reinterpret_cast<const char*>(xs[k].data()),
                                                static_cast<std::size_t>(xs[k].size()) * sizeof(double));
           sent[k] = Clock::now();
-          send(task, w, kTask);
+          if (!send_within(task, w, kTask, impl_.rank_timeout, impl_.abandoned))
+            throw impl_.lost_rank(w, "evaluating samples");
           impl_.traffic.tasks += 1;
           impl_.traffic.task_bytes += static_cast<long long>(task.size());
           ++held[static_cast<std::size_t>(w)];
