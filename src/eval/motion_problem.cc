@@ -149,12 +149,19 @@ std::shared_ptr<const Outcome> MotionProblem::confirm(const Eigen::VectorXd& x, 
     confirmed->robust_steps = verdict.steps;
     confirmed->robust_held = verdict.holds;
     if (!verdict.holds) {
-      confirmed->task_constraint += robust_failure_penalty(evaluator_->task());
-      confirmed->constraint = confirmed->task_constraint;
-      if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(*confirmed);
+      add_task_term(*confirmed, robust_failure_penalty(evaluator_->task()));
     }
   }
   return confirmed;
+}
+
+// A confirmation's term added to the task's C, then the bounds' terms on top, in the order
+// evaluate() adds them.
+void MotionProblem::add_task_term(MotionOutcome& out, double term) const {
+  out.task_constraint += term;
+  out.constraint = out.task_constraint;
+  out.failed = !std::isfinite(out.constraint);
+  if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(out);
 }
 
 void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, MotionOutcome& out) const {
@@ -177,10 +184,7 @@ void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, 
   // the suite's part: the task itself is not met there.
   if (bounds_.robust && penalty > 0) penalty += 2 * robust_failure_penalty(evaluator_->task());
   // In the order TaskEvaluator::evaluate adds it (0 + penalty), then the bounds' terms.
-  out.task_constraint += penalty;
-  out.constraint = out.task_constraint;
-  out.failed = !std::isfinite(out.constraint);
-  if (bounds_.effort > 0 || bounds_.distance > 0) apply_bounds(out);
+  add_task_term(out, penalty);
   out.check_steps = fine.stats.steps;
 }
 

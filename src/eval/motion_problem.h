@@ -195,6 +195,7 @@ class MotionProblem : public DiversityProblem {
   void apply_bounds(MotionOutcome& outcome) const;
   // The half-timestep check of confirm(), on `outcome` (a copy of the provisional one).
   void confirm_half_timestep(const Eigen::VectorXd& x, int worker, MotionOutcome& outcome) const;
+  void add_task_term(MotionOutcome& outcome, double term) const;
 
   const TaskEvaluator* evaluator_;
   DistanceSpec distance_;
