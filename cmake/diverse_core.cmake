@@ -71,6 +71,13 @@ target_link_libraries(diverse_core PUBLIC
   Eigen3::Eigen diverse_mujoco tomlplusplus::tomlplusplus
   nlohmann_json::nlohmann_json Threads::Threads PNG::PNG ${OSMESA_LIBRARY})
 target_include_directories(diverse_core SYSTEM PRIVATE ${OSMESA_INCLUDE_DIR})
+# Nearly every stage includes Eigen, nlohmann-json and MuJoCo: compiled once, not once per
+# source file. The libFuzzer build leaves them out (DIVERSE_PRECOMPILE_HEADERS OFF), so
+# each file's own includes are still checked there.
+if(DIVERSE_PRECOMPILE_HEADERS)
+  target_precompile_headers(diverse_core PRIVATE
+    <Eigen/Dense> <nlohmann/json.hpp> <mujoco/mujoco.h> <algorithm> <memory> <string> <vector>)
+endif()
 target_link_libraries(diverse_core PRIVATE TinyGLTF::TinyGLTF)
 if(DIVERSE_HAS_MPI)
   target_link_libraries(diverse_core PRIVATE MPI::MPI_CXX)

@@ -169,6 +169,7 @@ void MotionProblem::confirm_half_timestep(const Eigen::VectorXd& x, int worker, 
   EvaluationOptions fine_options;
   fine_options.samples_per_phase = 0;
   fine_options.timestep_scale = 0.5;
+  fine_options.end_when_decided = evaluator_->task().walk.enabled;
   MotionOutcome scratch;
   const Evaluation fine = run(x, worker, fine_options, scratch);
   MotionSummary landed;
@@ -258,7 +259,13 @@ void MotionProblem::apply_bounds(MotionOutcome& outcome) const {
 std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::VectorXd& x,
                                                                int worker) const {
   auto outcome = std::make_shared<MotionOutcome>();
-  const Evaluation e = run(x, worker, EvaluationOptions{}, *outcome);
+  // A walk ends at the step that breaks its rules (its C extrapolated from the steps so
+  // far, task/walk_task.h). A jump runs to its end: whether a landing that misses the task
+  // stands or falls decides its C, and only the rest of the rollout tells
+  // (docs/results.md, "Where a run's steps go").
+  EvaluationOptions options;
+  options.end_when_decided = evaluator_->task().walk.enabled;
+  const Evaluation e = run(x, worker, options, *outcome);
   outcome->constraint = e.constraint;
   outcome->task_constraint = e.constraint;
   outcome->effort = e.stats.effort;

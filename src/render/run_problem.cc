@@ -70,7 +70,7 @@ RunProblem open_run_problem(const RunView& run, int threads, const std::string& 
 }
 
 std::vector<RunPathPoint> read_run_path(const RunView& run, std::size_t variation, const ParameterSet& like) {
-  const fs::path file = run.dir / "paths" / ("m" + std::to_string(variation) + ".json");
+  const fs::path file = run.dir / "paths" / std::string("m").append(std::to_string(variation)).append(".json");
   if (!fs::exists(file))
     throw UserError(file.string() + ": missing; the run directory is incomplete (`diverse resume " +
                     run.dir.string() + "` writes its outputs again)");

@@ -53,6 +53,10 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
   const double progress = std::clamp(motion.fall_progress, 0.0, 1.0);
   add("fall", motion.fell ? 1 : 0, motion.fell ? c.fall_penalty * (2 - progress) : 0);
   report.fell = motion.fell;
+  // A rollout ended once it could no longer meet the task counts as a fall at the end of
+  // the motion: most such landings do fall later (85 of 105 around jump_high's M0), and a
+  // C without it would rank them above every motion that stands longer before falling.
+  if (motion.ended_decided) add("ended_decided", 1, c.fall_penalty);
 
   // The larger violation of the feet at touch-down and at rest.
   auto at_touchdown_and_rest = [&](auto violation) {

@@ -50,9 +50,12 @@ struct MotionSummary {
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
-  // The rollout was ended once the motion had landed and could no longer meet the task
-  // (EvaluationOptions::end_when_decided): the feet "at rest" are where they were then,
-  // and the rotation from standing to standing, known only at rest, counts as met.
+  // The rollout was ended once the motion could no longer meet the task
+  // (EvaluationOptions::end_when_decided). A jump (ended once landed): the feet "at rest"
+  // are where they were then, the rotation from standing to standing, known only at rest,
+  // counts as met, and the term "ended_decided" adds fall_penalty, a fall at the end of
+  // the motion. A walk (ended at the step that broke the rules): the term extrapolates
+  // its steps' excesses to all its evaluated steps (task/walk_task.h).
   bool ended_decided = false;
   WalkSummary walk;           // a walk task's steps (task/walk_task.h)
 };

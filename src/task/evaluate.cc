@@ -471,7 +471,7 @@ Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& driv
                                         SimWorker& worker, const EvaluationOptions& options) const {
   Evaluation e;
   mjModel* m = worker.model();
-  WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, e);
+  WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.walk.max_time / m->opt.timestep)) + 1;
   simulate(task_, body, controller, drive, hooks, max_steps, worker, options, e);
   if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);

@@ -58,14 +58,16 @@ struct EvaluationOptions {
   // asks for it only where it decides something (eval/motion_problem.h, confirm()); the
   // input-motion search checks both timesteps itself.
   bool half_timestep_check = false;
-  // End a jump's rollout as soon as it has landed and its outcome is decided (see
-  // Evaluation::steps_after_decided; MotionSummary::ended_decided): its C is then what was
-  // known at that moment, every term the rest could only make worse (touchdown_bound()),
-  // without a later fall. A motion that meets the task is never ended, so it is simulated
-  // exactly as without the option. The optimizer does not use it: that C orders the
-  // samples that miss the task differently from the full rollout's (about half of their
-  // pairs), and the default job's result got worse with it (docs/results.md, "Where a
-  // run's steps go").
+  // End the rollout as soon as its outcome is decided (see Evaluation::steps_after_decided;
+  // MotionSummary::ended_decided): a jump once it has landed where it can no longer meet
+  // the task, counted as a fall at the end of the motion (most such landings do fall
+  // later); a walk at the step that first breaks the rules, its steps' excesses
+  // extrapolated to all its evaluated steps. A motion that meets the task is never ended,
+  // so it is simulated exactly as without the option. The optimizer's walk rollouts use
+  // it; its jumps do not (whether an ended landing would stand decides its C, and
+  // every constant in its place lowered D: docs/results.md, "Where a run's steps go").
+  // Motion files, the robustness suite and the input-motion search simulate every
+  // rollout to its end.
   bool end_when_decided = false;
   // Perturbations of the robustness suite (robust/robustness.h), never set by the
   // optimizer, the input-motion search or a run: they are disturbances from the world

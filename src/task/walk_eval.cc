@@ -50,8 +50,10 @@ std::array<bool, 2> feet_on_ground(const mjModel* m, const mjData* d, const Char
 }  // namespace
 
 WalkObserver::WalkObserver(const Task& task, const Character& body, const mjModel* m,
-                           Controller& controller, JointDrive& drive, int samples, Evaluation& out)
-    : task_(task), body_(body), controller_(controller), drive_(drive), samples_(samples), out_(out) {
+                           Controller& controller, JointDrive& drive, int samples, bool end_when_decided,
+                           Evaluation& out)
+    : task_(task), body_(body), controller_(controller), drive_(drive), samples_(samples),
+      end_when_decided_(end_when_decided), out_(out) {
   nq_ = m->nq;
   const auto standing = standing_orientations(m);
   root_up_ = up_in(standing[static_cast<size_t>(body.root_body)]);
@@ -160,8 +162,14 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
         tilt_ = 0;
         // Every evaluated step adds its excess to C, so one out of range decides it.
         if (decided_ < 0 && static_cast<int>(walk.steps.size()) > w.settle_steps &&
-            walk_constraints(task_, s).total > 0)
+            walk_constraints(task_, s).total > 0) {
           decided_ = index_;
+          if (end_when_decided_) {
+            s.ended_decided = true;
+            s.end_time = t;
+            return true;
+          }
+        }
       }
       last_leg_ = f;
     }

@@ -36,8 +36,10 @@ class WalkObserver : public StepHooks {
  public:
   // `m` is the model the rollout runs (standing orientations are read from it); `out`
   // receives the summary (out.summary: fell, walk steps).
+  // With end_when_decided the walk ends at the step that first breaks the task's rules
+  // (EvaluationOptions::end_when_decided; MotionSummary::ended_decided).
   WalkObserver(const Task& task, const Character& body, const mjModel* m, Controller& controller,
-               JointDrive& drive, int samples, Evaluation& out);
+               JointDrive& drive, int samples, bool end_when_decided, Evaluation& out);
 
   void control(mjModel* m, mjData* d) override;
   bool observe(const mjModel* m, const mjData* d) override;
@@ -61,6 +63,7 @@ class WalkObserver : public StepHooks {
   Controller& controller_;
   JointDrive& drive_;
   int samples_;
+  bool end_when_decided_;
   Evaluation& out_;
   ContactState contacts_;
   bool first_ = true;

@@ -76,6 +76,15 @@ ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion)
   add("step_lateral", std::sqrt(lateral), c.weight * lateral);
   add("upright", std::sqrt(tilt), c.weight * tilt);
   add("turn", turn, c.weight * turn * turn);
+  // A walk ended at the step that first broke the rules (MotionSummary::ended_decided):
+  // its evaluated steps so far stand for all of them, as a walk that has settled into its
+  // gait repeats its steps, so their excesses count (evaluated steps) / (steps so far)
+  // times.
+  if (motion.ended_decided) {
+    const double evaluated = static_cast<double>(w.steps - w.settle_steps);
+    const double so_far = std::max(1.0, static_cast<double>(steps.size()) - w.settle_steps);
+    add("ended_decided", evaluated / so_far, (evaluated / so_far - 1) * c.weight * (forward + lateral + tilt));
+  }
   return report;
 }
 

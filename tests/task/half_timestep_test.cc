@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <vector>
 #include <string>
+#include <utility>
 
 #include "core/rng.h"
 #include "eval/motion_problem.h"
@@ -217,25 +218,34 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
     EXPECT_GT(decided, 0);
   }
   // Ended when decided (the optimizer's samples): a motion that meets the task runs as
-  // before, bit for bit; one that is ended still misses it, with a C no larger than its
-  // full rollout's (what the rest could only add is left out), in nearly the same order.
+  // before, bit for bit; one that is ended still misses it, with its landing terms and a
+  // fall at the end of the motion (the term "ended_decided"). Most such landings do fall
+  // later, so that C puts more pairs of samples in the full rollout's order than the same
+  // C without the fall would.
   {
-    const Task task = load_task(kTasks + "jump_forward.toml");
+    const Task task = load_task(kTasks + "jump_high.toml");
     const TaskEvaluator ev(task);
     const ParameterSet m0 = ev.load_parameters(task.m0);
     auto worker = ev.make_worker();
     EvaluationOptions full, ended;
     full.samples_per_phase = ended.samples_per_phase = 10;
     ended.end_when_decided = true;
+    const double fall_penalty = task.constraints.fall_penalty;
     Rng rng(derive_seed(5, {1}));
-    std::vector<double> c_full, c_ended;
-    int count_ended = 0;
-    for (int k = 0; k < 40; ++k) {
+    std::vector<double> c_full, c_ended, c_without_fall;
+    int count_ended = 0, ended_fell_later = 0;
+    long long steps_full = 0, steps_ended = 0;
+    for (int k = 0; k < 48; ++k) {
       Eigen::VectorXd x = m0.normalized();
       if (k > 0)
         for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j] + 0.03 * rng.normal(), 0.0, 1.0);
       const Evaluation a = ev.evaluate_normalized(x, *worker, full);
       const Evaluation b = ev.evaluate_normalized(x, *worker, ended);
+      steps_full += a.stats.steps;
+      steps_ended += b.stats.steps;
+      c_full.push_back(a.constraint);
+      c_ended.push_back(b.constraint);
+      c_without_fall.push_back(b.summary.ended_decided ? b.constraint - fall_penalty : b.constraint);
       if (!b.summary.ended_decided) {
         EXPECT_EQ(a.constraint, b.constraint) << "sample " << k;
         EXPECT_EQ(a.stats.steps, b.stats.steps) << "sample " << k;
@@ -243,21 +253,38 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
         continue;
       }
       ++count_ended;
-      EXPECT_GT(b.constraint, 0.0) << "sample " << k;
-      EXPECT_LE(b.constraint, a.constraint) << "sample " << k;
+      ended_fell_later += a.fell;
+      EXPECT_GT(a.constraint, 0.0) << "sample " << k;
+      EXPECT_FALSE(b.fell) << "sample " << k;
       EXPECT_LT(b.stats.steps, a.stats.steps) << "sample " << k;
-      c_full.push_back(a.constraint);
-      c_ended.push_back(b.constraint);
+      EXPECT_EQ(b.poses.size(), a.poses.size()) << "sample " << k;  // the flight is whole
+      bool has_term = false;
+      for (const ConstraintTerm& t : b.report.terms)
+        if (t.name == "ended_decided") has_term = t.penalty == fall_penalty;
+      EXPECT_TRUE(has_term) << "sample " << k;
+      EXPECT_GE(b.constraint, fall_penalty) << "sample " << k;
     }
-    EXPECT_GT(count_ended, 3);
-    // Pairs of ended samples in the same order by either C.
-    int pairs = 0, same = 0;
-    for (std::size_t i = 0; i < c_full.size(); ++i)
-      for (std::size_t j = i + 1; j < c_full.size(); ++j) {
-        ++pairs;
-        same += (c_full[i] < c_full[j]) == (c_ended[i] < c_ended[j]);
-      }
-    std::printf("ended %d of 40; %d of %d pairs in the same order\n", count_ended, same, pairs);
+    EXPECT_GT(count_ended, 8);
+    EXPECT_GT(2 * ended_fell_later, count_ended);  // most of them fall later
+    // Pairs with at least one ended sample in the same order as the full rollouts'.
+    auto same_order = [&](const std::vector<double>& c) {
+      int same = 0, pairs = 0;
+      for (std::size_t i = 0; i < c_full.size(); ++i)
+        for (std::size_t j = i + 1; j < c_full.size(); ++j) {
+          if (c_ended[i] == c_full[i] && c_ended[j] == c_full[j]) continue;  // neither ended
+          ++pairs;
+          same += (c_full[i] < c_full[j]) == (c[i] < c[j]);
+        }
+      return std::make_pair(same, pairs);
+    };
+    const auto [same, pairs] = same_order(c_ended);
+    const auto [same_without, pairs_without] = same_order(c_without_fall);
+    std::printf("ended %d of 48 (%d fell later), %.1f %% of the steps; pairs in the full order: %d of %d "
+                "(without the fall term %d)\n",
+                count_ended, ended_fell_later, 100.0 * static_cast<double>(steps_ended) / static_cast<double>(steps_full),
+                same, pairs, same_without);
+    EXPECT_GT(same, same_without);
+    EXPECT_LT(steps_ended, steps_full * 9 / 10);
   }
 
   // The landing box a metre further on: M0 lands short of it, decided at touch-down.

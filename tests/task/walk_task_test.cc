@@ -379,6 +379,27 @@ TEST(WalkHalfTimestep, InputWalksHoldAtHalfTheStep) {
     EXPECT_GT(n.steps_after_decided, 0);
     EXPECT_NEAR(n.decided_step * narrow.model().get()->opt.timestep,
                 n.summary.walk.steps[static_cast<size_t>(task.walk.settle_steps)].time, 0.01);
+
+    // Ended there (the optimizer's rollouts): the walk stops at that step, and its one
+    // evaluated step stands for all of them. These walks repeat their strides, so the
+    // extrapolated C is within 15 % of the whole walk's (the human's 2 %, the robot's 10 %:
+    // its left and right steps differ), from about a third of the steps.
+    EvaluationOptions ended = checked;
+    ended.end_when_decided = true;
+    const Evaluation x = narrow.evaluate(m0.values(), *narrow.make_worker(), ended);
+    EXPECT_TRUE(x.summary.ended_decided);
+    EXPECT_FALSE(x.fell);
+    EXPECT_EQ(x.summary.walk.steps.size(), static_cast<size_t>(task.walk.settle_steps) + 1);
+    EXPECT_LT(x.stats.steps, n.stats.steps / 2);
+    EXPECT_NEAR(x.constraint, n.constraint, 0.15 * n.constraint);
+    const auto extra = std::find_if(x.report.terms.begin(), x.report.terms.end(),
+                                    [](const ConstraintTerm& t) { return t.name == "ended_decided"; });
+    ASSERT_NE(extra, x.report.terms.end());
+    EXPECT_EQ(extra->violation, task.walk.steps - task.walk.settle_steps);
+    // The input walk itself is never ended.
+    const Evaluation m = ev.evaluate(m0.values(), *ev.make_worker(), ended);
+    EXPECT_EQ(m.constraint, 0.0);
+    EXPECT_EQ(m.stats.steps, e.stats.steps);
   }
 }
 
