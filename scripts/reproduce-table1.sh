@@ -18,6 +18,10 @@
 # The paper ran about 2000 generations per run (2 hours on 8 cores); that is the default
 # here too. On a small machine pass a smaller budget: the table is labelled with it.
 # A task whose input motion (its m0 file) does not exist yet is left out, with a note.
+# The script can be stopped at any moment and started again with the same arguments: a
+# finished run with the same settings is kept, an interrupted one continues from its
+# checkpoint (`diverse resume`, the same result as uninterrupted), anything else is run
+# afresh.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 generations=2000
@@ -49,15 +53,30 @@ for task in jump_forward backflip; do
 done
 ((${#tasks[@]})) || { echo "reproduce-table1.sh: no task has an input motion" >&2; exit 1; }
 
+# Does DIR hold a run of this table (task, objective, seed, generations)?
+same_run() {
+  [ -f "$1/run.json" ] &&
+    jq -e --arg t "$2" --arg m "$3" --argjson seed "$4" --argjson g "$generations" \
+      '(.task_file | sub(".*/"; "") | sub("\\.toml$"; "")) == $t and .metric == $m and .vary == ["control", "shape"] and .options.seed == $seed and .options.max_generations == $g and .options.variations == 4' \
+      "$1/run.json" >/dev/null 2>&1
+}
+
 mkdir -p "$out"
 start=$SECONDS
 for task in "${tasks[@]}"; do
   for objective in md shape; do
     for seed in 1 2 3; do
       dir="$out/$task-$objective-$seed"
-      echo "$task, objective $objective, seed $seed -> $dir" >&2
-      "$diverse" run "$task" --vary shape --metric "$objective" --n 4 --generations "$generations" \
-        --seed "$seed" --threads "$threads" --out "$dir" --force --quiet --no-render
+      if same_run "$dir" "$task" "$objective" "$seed" && [ -f "$dir/summary.json" ]; then
+        echo "$task, objective $objective, seed $seed: finished earlier, kept ($dir)" >&2
+      elif same_run "$dir" "$task" "$objective" "$seed" && [ -f "$dir/checkpoint.json" ]; then
+        echo "$task, objective $objective, seed $seed: resuming ($dir)" >&2
+        "$diverse" resume "$dir" --threads "$threads" --quiet --no-render
+      else
+        echo "$task, objective $objective, seed $seed -> $dir" >&2
+        "$diverse" run "$task" --vary shape --metric "$objective" --n 4 --generations "$generations" \
+          --seed "$seed" --threads "$threads" --out "$dir" --force --quiet --no-render
+      fi
     done
   done
 done
