@@ -21,7 +21,8 @@
 # The script can be stopped at any moment and started again with the same arguments: a
 # finished run with the same settings is kept, an interrupted one continues from its
 # checkpoint (`diverse resume`, the same result as uninterrupted), anything else is run
-# afresh.
+# afresh. TASKS="jump_forward" (or "backflip") runs and tables only that task, so the
+# long backflip rows can be run apart from the forward jump's.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 generations=2000
@@ -43,7 +44,11 @@ command -v jq >/dev/null || { echo "reproduce-table1.sh: needs jq (scripts/setup
 
 tasks=()
 notes=()
-for task in jump_forward backflip; do
+for task in ${TASKS:-jump_forward backflip}; do
+  case "$task" in
+    jump_forward|backflip) ;;
+    *) echo "reproduce-table1.sh: TASKS: expected jump_forward and/or backflip, got '$task'" >&2; exit 2 ;;
+  esac
   m0="$(sed -n 's/^m0 *= *"\(.*\)"/\1/p' "$here/tasks/$task.toml")"
   if [ -f "$here/tasks/$m0" ]; then
     tasks+=("$task")
