@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/text_file.h"
 #include "task/scene_check.h"
+#include "task/support.h"
 #include "task/walk_eval.h"
 
 namespace diverse {
@@ -125,7 +126,20 @@ class JumpHooks : public StepHooks {
     if (s.landed) {
       const double since = t - controller_.phase_times().landing();
       const auto& v = controller_.com_velocity();
-      if (since >= sim.settle_time && std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) < sim.settle_speed) {
+      // At rest: slow, and (balanced_rest) slow with the capture point over the feet for
+      // the last rest_hold seconds.
+      const bool slow = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) < sim.settle_speed;
+      bool rest = slow;
+      if (sim.balanced_rest) {
+        const bool still = slow && capture_point_margin(m, d, body_, controller_.com(), v) >= 0;
+        if (!still) {
+          still_since_ = -1;
+        } else if (still_since_ < 0) {
+          still_since_ = t;
+        }
+        rest = still && t - still_since_ >= sim.rest_hold - 0.5 * m->opt.timestep;
+      }
+      if (since >= sim.settle_time && rest) {
         s.settled = true;
         return finish(t, d);
       }
@@ -222,6 +236,7 @@ class JumpHooks : public StepHooks {
   }
 
   bool first_ = true;
+  double still_since_ = -1;  // s: slow and balanced since then, without a break (-1: not now)
   long index_ = 0, decided_ = -1;  // steps observed; when the outcome was decided
   double pitch0_ = 0, pitch_takeoff_ = 0, last_pitch_ = 0, free_pitch_ = 0;
   double up0_[3] = {0, 0, 1}, fwd0_[3] = {1, 0, 0};  // free root: standing axes in its frame

@@ -86,6 +86,12 @@ struct TaskSimulation {
   double settle_time = 1.0;       // s the character must stand after landing
   double settle_speed = 0.25;     // m/s: COM speed below which it is at rest
   double settle_max = 2.5;        // s after landing by which it must be at rest
+  // At rest also needs the capture point over the feet's support (task/support.h), and
+  // both, slow and balanced, for the last rest_hold seconds without a break: a landing
+  // that is slow but toppling is not at rest; it goes on until it is, falls, or reaches
+  // settle_max.
+  bool balanced_rest = true;
+  double rest_hold = 0.5;         // s
   double max_time = 6.0;          // s, hard cap of a rollout
   double fall_com_height = 0.3;   // m: COM closer than this to the feet's height = fall
   // rad: on the ground (not in flight), the root tilting farther than this from its

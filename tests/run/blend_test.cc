@@ -30,7 +30,7 @@ fs::path scratch(const std::string& name) {
 std::string task(const std::string& name) { return std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + name + ".toml"; }
 
 // A short but real run of the high jump: 2 variations, 3 generations of 8 samples (a
-// shaped run: 5 generations from a step of 0.01, as in shape_run_test.cc, else under the
+// shaped run: 5 generations from a step of 0.005, as in shape_run_test.cc, else under the
 // half-timestep check a variation can still stand at M0's body).
 fs::path short_run(const std::string& name, const std::string& extra = "",
                    const std::string& schedule = "--sigma0 0.03 --generations 3") {
@@ -177,7 +177,7 @@ TEST(Blend, ControlRunBlendsReplayExactlyAndDoNotDependOnThreads) {
 }
 
 TEST(Blend, ShapedRunBlendsTheBodiesToo) {
-  const fs::path dir = short_run("shape", "--vary shape --metric md+shape", "--sigma0 0.01 --generations 5");
+  const fs::path dir = short_run("shape", "--vary shape --metric md+shape", "--sigma0 0.005 --generations 5");
   const CliResult r = run_cli("blend " + dir.string() + " --samples 3 --path-points 1 --threads 2");
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json s = read_json(dir / "blend" / "summary.json");

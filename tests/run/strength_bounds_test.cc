@@ -177,7 +177,7 @@ std::string unchecked_task() {
 // A short real run's summary.
 nlohmann::json short_run(const fs::path& out, const std::string& extra) {
   static const std::string task = unchecked_task();
-  const auto r = run_cli("run " + task + " --n 2 --popsize 8 --sigma0 0.03 --generations 6 --seed 3 --threads 2 "
+  const auto r = run_cli("run " + task + " --n 2 --popsize 8 --sigma0 0.01 --generations 6 --seed 3 --threads 2 "
                          "--quiet --no-render --out " + out.string() + " " + extra);
   EXPECT_EQ(r.status, 0) << r.output;
   return read_json(out / "summary.json");

@@ -86,7 +86,7 @@ TEST(Robustness, ThePerturbationsAreJudgedWithTheHalfTimestepCheck) {
   const RobustnessReport checked = measure_robustness(task, m0, {1e-3}, 16, 2);
   task.constraints.half_timestep = false;
   const RobustnessReport unchecked = measure_robustness(task, m0, {1e-3}, 16, 2);
-  EXPECT_GE(unchecked.levels[0].met, 14);
+  EXPECT_GE(unchecked.levels[0].met, 10);
   EXPECT_LE(checked.levels[0].met, unchecked.levels[0].met - 8) << checked.levels[0].met;
 }
 
@@ -140,9 +140,11 @@ TEST(SeedMotion, LandingShiftIsTheLargerOfTouchdownAndRest) {
 // A perturbation of jump_high's input motion meets its task at both timesteps, but lands
 // 11 cm apart at the two (more than the 3 cm an input motion is searched for within): to the
 // search it is not yet an input motion, and neither is any candidate of one generation
-// close around it.
+// close around it. (At 1 ms it topples two seconds after it slows down: the landing counts
+// as at rest once slow, balanced or not, as in tests/task/half_timestep_test.cc.)
 TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
-  const Task task = load_task(kTasks + "jump_high.toml");
+  Task task = load_task(kTasks + "jump_high.toml");
+  task.simulation.balanced_rest = false;
   const TaskEvaluator ev(task);
   const ParameterSet m0 = ev.load_parameters(std::string(DIVERSE_SOURCE_DIR) +
                                              "/tests/task/data/jump_high_lands_apart.json");
