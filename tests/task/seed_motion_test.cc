@@ -76,8 +76,9 @@ TEST(Robustness, TellsAMotionsNeighbourhoodFromRandomControllers) {
 
 // A perturbation meets the task as the diversity optimizer judges it: where the task has
 // the half-timestep check, one that meets it at 2 ms but lands elsewhere (or falls) at 1 ms
-// does not count. The high jump's input motion lands 2.8 cm apart at the two timesteps
-// (3 cm allowed): steps of a thousandth of the ranges already part some of them.
+// does not count. The high jump's input motion lands 2.0 cm apart at the two timesteps
+// (3 cm allowed): steps of a thousandth of the ranges already part some of them (6 of
+// the 16 that meet the task at 2 ms).
 TEST(Robustness, ThePerturbationsAreJudgedWithTheHalfTimestepCheck) {
   Task task = load_task(kTasks + "jump_high.toml");
   ASSERT_TRUE(task.constraints.half_timestep);
@@ -87,7 +88,7 @@ TEST(Robustness, ThePerturbationsAreJudgedWithTheHalfTimestepCheck) {
   task.constraints.half_timestep = false;
   const RobustnessReport unchecked = measure_robustness(task, m0, {1e-3}, 16, 2);
   EXPECT_GE(unchecked.levels[0].met, 10);
-  EXPECT_LE(checked.levels[0].met, unchecked.levels[0].met - 8) << checked.levels[0].met;
+  EXPECT_LE(checked.levels[0].met, unchecked.levels[0].met - 4) << checked.levels[0].met;
 }
 
 TEST(SeedMotion, AFlightRotationRequirementTheMotionMissesIsAViolation) {
@@ -165,8 +166,8 @@ TEST(SeedMotion, LandingSpotsApartAtTheTwoTimestepsAreAViolation) {
 // A requirement beyond the task is judged only on candidates that meet the task at both
 // timesteps, and one it rejects gets its penalty: with a requirement that rejects
 // everything, no candidate near jump_high's input motion (which meets the task) is
-// accepted. (A millionth of the ranges from it, some candidates already miss the task by
-// a hair: it lands 2.8 cm apart at the two timesteps, 3 cm allowed.)
+// accepted. (A millionth of the ranges from it, some candidates may miss the task by a
+// hair: it lands 2.0 cm apart at the two timesteps, 3 cm allowed.)
 TEST(SeedMotion, ARequirementIsJudgedOnlyOnCandidatesThatMeetTheTask) {
   const Task task = load_task(kTasks + "jump_high.toml");
   const TaskEvaluator ev(task);
