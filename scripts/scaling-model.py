@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Predicted wall time per generation and utilization of R ranks (docs/scaling.md).
 
-    scripts/scaling-model.py RUN_DIR... [--strategy round-robin|simultaneous|both]
+    scripts/scaling-model.py RUN_DIR... [--batches per-variation|per-generation|both]
                              [--popsize 16] [--n 4] [--threads 1] [--overhead-us US]
 
 Reads the rollout times a run measured (RUN_DIR/summary.json, "timing"):
@@ -11,8 +11,10 @@ Reads the rollout times a run measured (RUN_DIR/summary.json, "timing"):
                                   time quantiles and the message overhead per rollout.
 Several RUN_DIRs: their deciles are averaged point by point.
 
-Models a generation: round-robin is N batches of lambda rollouts (one variation after
-another), simultaneous one batch of N x lambda. Each batch is handed out dynamically to
+Models a generation as N batches of lambda rollouts (per-variation: round-robin standing
+at means, the progressive strategy) or one batch of N x lambda (per-generation: the
+default round-robin at best samples, the simultaneous strategy; src/optimize/diversity.h,
+"Batches"). Each batch is handed out dynamically to
 R x threads slots (the next free slot takes the next sample, as src/distribute does) and
 lasts until its last rollout ends; every rollout that rank 0 does not compute itself
 costs the overhead on top (measured under mpirun, or --overhead-us). Rollout times are
@@ -69,14 +71,14 @@ def batch_time(times, slots, local_slots, overhead):
     return max(free)
 
 
-def model(draw, strategy, n, popsize, threads, overhead, trials, ranks_list, rng):
+def model(draw, batching, n, popsize, threads, overhead, trials, ranks_list, rng):
     rows = []
     base = None
     for ranks in ranks_list:
         slots = ranks * threads
         wall = work = 0.0
         for _ in range(trials):
-            batches = [popsize] * n if strategy == "round-robin" else [n * popsize]
+            batches = [popsize] * n if batching == "per-variation" else [n * popsize]
             for size in batches:
                 times = [draw(rng) for _ in range(size)]
                 work += sum(times)
@@ -90,7 +92,7 @@ def model(draw, strategy, n, popsize, threads, overhead, trials, ranks_list, rng
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("runs", nargs="+")
-    ap.add_argument("--strategy", default="both", choices=["round-robin", "simultaneous", "both"])
+    ap.add_argument("--batches", default="both", choices=["per-variation", "per-generation", "both"])
     ap.add_argument("--popsize", type=int, default=16)
     ap.add_argument("--n", type=int, default=4)
     ap.add_argument("--threads", type=int, default=1, help="threads per rank")
@@ -107,13 +109,13 @@ def main():
     print(f"# lambda {a.popsize}, N {a.n}, {a.threads} thread(s) per rank; rollout p50 {median:.2f} ms, "
           f"p90 {next(t for u, t in quantiles if u >= 0.9):.2f} ms, max {quantiles[-1][1]:.2f} ms; "
           f"overhead {overhead * 1000:.0f} us per remote rollout")
-    strategies = ["round-robin", "simultaneous"] if a.strategy == "both" else [a.strategy]
-    for strategy in strategies:
+    batchings = ["per-variation", "per-generation"] if a.batches == "both" else [a.batches]
+    for batching in batchings:
         rng = random.Random(1)
-        print(f"{strategy}: ranks  ms/generation  speed-up  utilization")
-        for ranks, per_gen, speedup, util in model(draw, strategy, a.n, a.popsize, a.threads, overhead,
+        print(f"{batching}: ranks  ms/generation  speed-up  utilization")
+        for ranks, per_gen, speedup, util in model(draw, batching, a.n, a.popsize, a.threads, overhead,
                                                    a.trials, ranks_list, rng):
-            print(f"{'':{len(strategy)}}  {ranks:5d}  {per_gen:13.1f}  {speedup:8.2f}  {100 * util:10.1f} %")
+            print(f"{'':{len(batching)}}  {ranks:5d}  {per_gen:13.1f}  {speedup:8.2f}  {100 * util:10.1f} %")
 
 
 if __name__ == "__main__":

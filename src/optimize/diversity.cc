@@ -275,21 +275,54 @@ void DiversityOptimizer::confirm_all(const std::vector<Eigen::VectorXd>& xs,
   confirmations_ += tally ? static_cast<long long>(open.size()) : 0;
 }
 
+std::vector<std::size_t> DiversityOptimizer::confirmation_order(
+    const std::vector<std::shared_ptr<const Outcome>>& outcomes, std::size_t first,
+    std::vector<double> C, std::vector<double> D, std::size_t width) const {
+  // Each confirmation that fails drops its sample below every sample that meets the
+  // constraints, so the loop of choose_confirmed() would take the candidates in their
+  // order until one holds: the best, the best of the rest, and so on, up to the first one
+  // that is confirmed already or the incumbent.
+  const std::size_t n = C.size() - 1;
+  std::vector<std::size_t> order;
+  while (order.size() < width) {
+    const std::size_t best = best_candidate(C, D);
+    if (best == n || !outcomes[first + best]->provisional) break;
+    order.push_back(best);
+    C[best] = std::numeric_limits<double>::infinity();
+    D[best] = -std::numeric_limits<double>::infinity();
+  }
+  return order;
+}
+
 std::size_t DiversityOptimizer::choose_confirmed(int v, const std::vector<Eigen::VectorXd>& xs,
                                                  std::vector<std::shared_ptr<const Outcome>>& outcomes,
                                                  std::size_t first, std::vector<double>& C,
                                                  std::vector<double>& D) {
   const std::size_t n = C.size() - 1;  // candidates; the last entry is the incumbent
+  // Confirmations run kConfirmWidth at a time: the winner's and those of the candidates
+  // that would be confirmed next if it failed (most fail, and one check alone would
+  // leave all workers but one idle). Only the ones the loop below asks for are used, so
+  // the choice is the same as with one check at a time; the others' steps are counted.
+  std::vector<std::shared_ptr<const Outcome>> checked_ahead(n);
   for (;;) {
     const std::size_t best = best_candidate(C, D);
     if (best == n || !outcomes[first + best]->provisional) return best;
     // The winner is provisional: confirm it, rank it again with its final C, and choose
     // again. A confirmation that holds ends the search; one that fails drops the sample.
-    std::vector<std::shared_ptr<const Outcome>> one{outcomes[first + best]};
-    confirm_all({xs[best]}, one, true);
-    outcomes[first + best] = one.front();
-    C[best] = scored_constraint(*one.front());
-    D[best] = replaced_objective(*problem_, outcomes_, current_, v, *one.front(), options_.k);
+    if (!checked_ahead[best]) {
+      const std::vector<std::size_t> order = confirmation_order(outcomes, first, C, D, kConfirmWidth);
+      std::vector<Eigen::VectorXd> ahead_x;
+      std::vector<std::shared_ptr<const Outcome>> ahead;
+      for (std::size_t k : order) {
+        ahead_x.push_back(xs[k]);
+        ahead.push_back(outcomes[first + k]);
+      }
+      confirm_all(ahead_x, ahead, true);
+      for (std::size_t i = 0; i < order.size(); ++i) checked_ahead[order[i]] = ahead[i];
+    }
+    outcomes[first + best] = checked_ahead[best];
+    C[best] = scored_constraint(*outcomes[first + best]);
+    D[best] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[first + best], options_.k);
   }
 }
 
@@ -423,8 +456,12 @@ bool DiversityOptimizer::step() {
   ++generation_;
   switch (options_.strategy) {
     case DiversityStrategy::kRoundRobin:
-      for (int v = 1; v <= options_.variations; ++v) {
-        if (cmas_[v - 1].stop_reason() == StopReason::kNone) step_variation(v);
+      if (options_.point == VariationPoint::kBestSample) {
+        step_round_robin();
+      } else {
+        for (int v = 1; v <= options_.variations; ++v) {
+          if (cmas_[v - 1].stop_reason() == StopReason::kNone) step_variation(v);
+        }
       }
       break;
     case DiversityStrategy::kProgressive:
@@ -449,6 +486,34 @@ void DiversityOptimizer::run() {
   }
 }
 
+void DiversityOptimizer::step_round_robin() {
+  // A rollout depends on its sample alone and variation v's samples on its own CMA
+  // instance alone, so every variation's samples of this generation are drawn and
+  // simulated in one batch (N x lambda rollouts keep more workers busy than lambda). Only
+  // the scoring depends on where the others stand: it runs variation by variation, each
+  // against the moves of those before it, exactly as one batch per variation would.
+  std::vector<int> active;
+  std::vector<std::vector<Eigen::VectorXd>> xs(static_cast<std::size_t>(options_.variations) + 1);
+  std::vector<Eigen::VectorXd> batch;
+  std::vector<std::size_t> first(xs.size(), 0);
+  for (int v = 1; v <= options_.variations; ++v) {
+    if (cmas_[v - 1].stop_reason() != StopReason::kNone) continue;
+    active.push_back(v);
+    xs[v] = cmas_[v - 1].ask();
+    first[v] = batch.size();
+    batch.insert(batch.end(), xs[v].begin(), xs[v].end());
+  }
+  const auto outcomes = evaluate_all(batch, false);
+  for (int v : active) {
+    const auto begin = outcomes.begin() + static_cast<std::ptrdiff_t>(first[v]);
+    std::vector<std::shared_ptr<const Outcome>> own(begin, begin + static_cast<std::ptrdiff_t>(xs[v].size()));
+    // Tallied as the variation's step comes, so the log counts steps as it always did.
+    for (const auto& outcome : own) problem_->tally(*outcome, ledger_);
+    evaluations_ += static_cast<long long>(xs[v].size());
+    move_to_best_sample(v, xs[v], own);
+  }
+}
+
 void DiversityOptimizer::step_variation(int v) {
   Cmaes& es = cmas_[v - 1];
   const std::vector<Eigen::VectorXd> xs = es.ask();
@@ -462,8 +527,13 @@ void DiversityOptimizer::step_variation(int v) {
     std::vector<std::shared_ptr<const Outcome>> mean{outcomes.back()};
     confirm_all({batch.back()}, mean, true);
     settle_pending(mean.front());
+    outcomes.pop_back();
   }
   evaluations_ += static_cast<long long>(xs.size());
+  if (options_.point == VariationPoint::kBestSample) {
+    move_to_best_sample(v, xs, outcomes);
+    return;
+  }
 
   // Each sample replaces M_v in the current set and is ranked by its D and its own C.
   std::vector<double> D(xs.size()), C(xs.size());
@@ -471,30 +541,36 @@ void DiversityOptimizer::step_variation(int v) {
     D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
     C[k] = scored_constraint(*outcomes[k]);
   });
-
-  if (options_.point == VariationPoint::kBestSample) {
-    // M_v becomes this generation's best sample if it beats M_v as it stands, confirmed
-    // (DiversityProblem::confirm) before it may; CMA-ES learns every confirmation's result.
-    D.push_back(current_.D);
-    C.push_back(current_.constraint[v]);
-    const std::size_t best = choose_confirmed(v, xs, outcomes, 0, C, D);
-    D.pop_back();
-    C.pop_back();
-    count_samples(outcomes, xs.size());
-    es.tell(fitness(C, D));
-    if (best < xs.size()) {
-      points_[v] = xs[best];
-      outcomes_[v] = outcomes[best];
-    }
-    finish_step(v);
-    return;
-  }
   count_samples(outcomes, xs.size());
   es.tell(fitness(C, D));
   // The new mean is what the other variations' samples are scored against from now on;
   // it is evaluated with the next batch (or at the end of the generation).
   points_[v] = es.mean();
   pending_ = v;
+}
+
+void DiversityOptimizer::move_to_best_sample(int v, const std::vector<Eigen::VectorXd>& xs,
+                                             std::vector<std::shared_ptr<const Outcome>>& outcomes) {
+  // Each sample replaces M_v in the current set and is ranked by its D and its own C.
+  std::vector<double> D(xs.size()), C(xs.size());
+  pool_->parallel_for(xs.size(), [&](std::size_t k, int) {
+    D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
+    C[k] = scored_constraint(*outcomes[k]);
+  });
+  // M_v becomes this generation's best sample if it beats M_v as it stands, confirmed
+  // (DiversityProblem::confirm) before it may; CMA-ES learns every confirmation's result.
+  D.push_back(current_.D);
+  C.push_back(current_.constraint[v]);
+  const std::size_t best = choose_confirmed(v, xs, outcomes, 0, C, D);
+  D.pop_back();
+  C.pop_back();
+  count_samples(outcomes, xs.size());
+  cmas_[v - 1].tell(fitness(C, D));
+  if (best < xs.size()) {
+    points_[v] = xs[best];
+    outcomes_[v] = outcomes[best];
+  }
+  finish_step(v);
 }
 
 void DiversityOptimizer::count_samples(const std::vector<std::shared_ptr<const Outcome>>& outcomes,

@@ -16,8 +16,8 @@
 //   joint        (baseline) one CMA-ES instance over all N x |P| parameters; a sample is
 //                a whole set M_1..M_N.
 //   simultaneous N CMA-ES instances as in round-robin, but every variation draws its
-//                generation at once: one batch of N x lambda rollouts (what keeps many
-//                cores busy; round-robin's batches hold lambda). Each sample replaces M_i
+//                generation at once: one batch of N x lambda rollouts, as best-sample
+//                round-robin's batches (below) hold too. Each sample replaces M_i
 //                in the set as it stood when the generation was drawn; each instance is
 //                told those scores. Then the variations move one after another (1..N),
 //                each to its best sample if that beats it among the others as they now
@@ -92,6 +92,16 @@
 // joint strategy, M_0 and a restored checkpoint's sets are confirmed at once. So every set
 // scored, kept or returned holds confirmed outcomes only, as if every sample had been
 // checked, at the cost of a few checks per generation instead of one per feasible sample.
+//
+// Batches. A rollout depends on its sample alone and variation v's samples on its own CMA
+// instance alone, so best-sample round-robin draws every variation's samples of a
+// generation at once and simulates them in one batch of N x lambda; only the scoring runs
+// variation by variation, each against the moves of those before it, so the variations
+// move exactly as with one batch per variation. Standing at means, a variation's samples
+// are scored against the new means before it, which need their own rollouts: one batch of
+// lambda per variation, the previous step's mean riding along. Confirmations run
+// kConfirmWidth at a time (choose_confirmed): a constant, so that the counts do not depend
+// on the threads.
 //
 // Determinism. CMA instance v (1..N; 0 for joint) draws from derive_seed(seed, {v}); a
 // generation's samples are drawn before any is evaluated, evaluated in parallel on the
@@ -282,12 +292,25 @@ class DiversityOptimizer {
   // the incumbent last), confirming the winner while it is provisional and choosing again
   // with its final C and D (updated in C, D and outcomes) until the winner is confirmed
   // or is the incumbent.
+  // Confirmations run this many at a time (choose_confirmed); a constant, so that the
+  // steps a run counts do not depend on its threads.
+  static constexpr std::size_t kConfirmWidth = 2;
+  // The candidates choose_confirmed() would confirm, in its order, if each failed: at most
+  // `width`, all provisional (C and D as it holds them, the incumbent last).
+  std::vector<std::size_t> confirmation_order(const std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                                              std::size_t first, std::vector<double> C,
+                                              std::vector<double> D, std::size_t width) const;
   std::size_t choose_confirmed(int v, const std::vector<Eigen::VectorXd>& xs,
                                std::vector<std::shared_ptr<const Outcome>>& outcomes,
                                std::size_t first, std::vector<double>& C, std::vector<double>& D);
   CmaesOptions cma_options(int dim, int instance) const;
   int present() const;  // motions in the current set, M_0 included
-  void step_variation(int variation);
+  void step_variation(int variation);  // one CMA generation of one variation
+  void step_round_robin();             // best-sample round-robin: one batch per generation
+  // Scores variation v's samples xs (outcomes, tallied) against the current set, moves
+  // M_v to the best if it beats M_v as it stands (confirmed first), tells CMA-ES.
+  void move_to_best_sample(int v, const std::vector<Eigen::VectorXd>& xs,
+                           std::vector<std::shared_ptr<const Outcome>>& outcomes);
   void step_joint();
   void step_simultaneous();
   void rescore();

@@ -1,5 +1,6 @@
 #include "optimize/diversity.h"
 
+#include <array>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -482,15 +483,17 @@ TEST(DiversitySimultaneous, EveryVariationsGenerationInOneBatch) {
     for (const auto& r : opt.log()) EXPECT_EQ(r.variation, 0);
     EXPECT_GT(opt.result().score.D, 0.0);
   }
-  // The same budget as round-robin, whose batches hold one variation's lambda.
+  // The same budget as round-robin standing at means, whose batches hold one variation's
+  // lambda and the previous step's new mean (the last one's alone at the generation's end).
   CountingBatch round_robin(problem);
   DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 5);
-  o.point = VariationPoint::kBestSample;
   DiversityOptimizer rr(problem, o, pool, &round_robin);
   rr.run();
-  EXPECT_EQ(round_robin.sizes.size(), 1u + 5 * 3);
-  EXPECT_EQ(round_robin.sizes.back(), 16u);
-  EXPECT_EQ(rr.evaluations(), 1 + 5 * 3 * 16);
+  EXPECT_EQ(round_robin.sizes.size(), 1u + 5 * 4);
+  EXPECT_EQ(round_robin.sizes[1], 16u);
+  EXPECT_EQ(round_robin.sizes[2], 17u);
+  EXPECT_EQ(round_robin.sizes[4], 1u);
+  EXPECT_EQ(rr.evaluations(), 1 + 5 * 3 * (16 + 1));
 }
 
 // Variation 1's first generation is the same in both strategies (the same CMA stream,
@@ -762,6 +765,43 @@ TEST_P(Confirmation, DeterministicAndResumable) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, Confirmation, kAllStrategies, strategy_test_name);
+
+}  // namespace
+}  // namespace diverse
+
+namespace diverse {
+namespace {
+
+// Best-sample round-robin simulates every variation's samples of a generation in one
+// batch and confirms two candidates at a time, yet moves exactly as with one batch per
+// variation and one check at a time. The reference is that run (the same seed, before
+// either): its best D, where the variations stand and how many checks it made.
+TEST(DiversityRoundRobin, OneBatchPerGenerationMovesAsOneBatchPerVariation) {
+  const CheckedBallProblem problem;
+  DiversityOptions o = small_options(DiversityStrategy::kRoundRobin, 30);
+  o.point = VariationPoint::kBestSample;
+  ThreadPool two(2);
+  CountingBatch batch(problem);
+  DiversityOptimizer opt(problem, o, two, &batch);
+  opt.run();
+  const DiversityResult r = opt.result();
+  EXPECT_EQ(r.score.D, 0x1.0572f9e52cc95p+4);
+  const std::vector<std::array<double, 3>> reference{
+      {0x1.999999999999ap-2, 0x1.999999999999ap-2, 0x1.999999999999ap-2},
+      {0x1.2dc74fc7cbe31p-2, 0x1.554d4ffeb2b89p-1, 0x1.f27925347cc6bp-2},
+      {0x1.8245d8363490fp-2, 0x1.82584caf72467p-2, 0x1.a1bb4e77248f2p-4},
+      {0x1.ccbbdfad4849dp-2, 0x1.b20594a7cef93p-4, 0x1.9ace4ac5446b6p-2}};
+  ASSERT_EQ(r.parameters.size(), reference.size());
+  for (std::size_t i = 0; i < reference.size(); ++i)
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(r.parameters[i][k], reference[i][static_cast<std::size_t>(k)]) << "M" << i;
+  // M_0, then one batch of N x lambda per generation.
+  ASSERT_EQ(batch.sizes.size(), 31u);
+  for (std::size_t g = 1; g < batch.sizes.size(); ++g) EXPECT_EQ(batch.sizes[g], 3u * 16u);
+  // One check at a time made 107; two at a time wastes the second where the first held.
+  EXPECT_EQ(opt.confirmations(), 114);
+  EXPECT_EQ(opt.confirmations(), problem.confirmations.load());
+  EXPECT_EQ(opt.ledger().value("total", 0LL), opt.evaluations() + opt.confirmations());
+}
 
 }  // namespace
 }  // namespace diverse

@@ -110,22 +110,26 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
 }
 
 // summary.json's timing.rollouts: every rollout of the run (M0 once, then N x lambda per
-// generation) with its CPU time, and the batches the strategy asked for: round-robin one
-// per variation and generation, simultaneous one per generation.
+// generation) with its CPU time, and the batches the strategy asked for: one per
+// generation (round-robin at best samples, simultaneous), or one per variation and
+// generation (round-robin at means, each batch but a generation's first with the
+// previous variation's new mean, and that last mean alone at the generation's end).
 TEST(Run, TimingHoldsTheRolloutsAndTheStrategysBatches) {
   struct Case {
-    const char* strategy;
-    long long batches, largest;
+    const char* options;
+    long long evaluations, batches, largest;
   };
-  for (const Case& c : {Case{"round-robin", 1 + 5 * 2, 8}, Case{"simultaneous", 1 + 5, 2 * 8}}) {
-    SCOPED_TRACE(c.strategy);
-    const fs::path dir = scratch(std::string("timing_") + c.strategy);
-    Result r = run_cli("run " + kShort + " --threads 2 --strategy " + c.strategy + " --out " + dir.string());
+  for (const Case& c : {Case{"--strategy round-robin", 1 + 5 * 2 * 8, 1 + 5, 2 * 8},
+                        Case{"--strategy simultaneous", 1 + 5 * 2 * 8, 1 + 5, 2 * 8},
+                        Case{"--strategy round-robin --point mean", 1 + 5 * 2 * (8 + 1), 1 + 5 * 3, 8 + 1}}) {
+    SCOPED_TRACE(c.options);
+    const fs::path dir = scratch(std::string("timing_") + std::to_string(c.batches) + "_" + std::to_string(c.largest));
+    Result r = run_cli("run " + kShort + " --threads 2 " + c.options + " --out " + dir.string());
     ASSERT_EQ(r.status, 0) << r.output;
     const auto s = read_json(dir / "summary.json");
-    EXPECT_EQ(s["evaluations"], 1 + 5 * 2 * 8);
+    EXPECT_EQ(s["evaluations"], c.evaluations);
     const auto& rollouts = s["timing"]["rollouts"];
-    EXPECT_EQ(rollouts["count"], 1 + 5 * 2 * 8);
+    EXPECT_EQ(rollouts["count"], c.evaluations);
     EXPECT_EQ(rollouts["batches"], c.batches);
     EXPECT_EQ(rollouts["batch_size"]["max"], c.largest);
     EXPECT_EQ(rollouts["batch_size"]["min"], 1);  // M0
