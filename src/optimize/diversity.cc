@@ -486,31 +486,48 @@ void DiversityOptimizer::run() {
   }
 }
 
+DiversityOptimizer::Drawn DiversityOptimizer::draw_generation() {
+  Drawn g;
+  g.xs.resize(static_cast<std::size_t>(options_.variations) + 1);
+  g.first.assign(g.xs.size(), 0);
+  for (int v = 1; v <= options_.variations; ++v) {
+    if (cmas_[v - 1].stop_reason() != StopReason::kNone) continue;
+    g.active.push_back(v);
+    g.xs[v] = cmas_[v - 1].ask();
+    g.first[v] = g.batch.size();
+    g.batch.insert(g.batch.end(), g.xs[v].begin(), g.xs[v].end());
+  }
+  return g;
+}
+
+void DiversityOptimizer::score_against_current(int v, const std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                                               std::size_t first, std::size_t n, std::vector<double>& C,
+                                               std::vector<double>& D) const {
+  C.resize(n);
+  D.resize(n);
+  pool_->parallel_for(n, [&](std::size_t k, int) {
+    const Outcome& o = *outcomes[first + k];
+    D[k] = replaced_objective(*problem_, outcomes_, current_, v, o, options_.k);
+    C[k] = scored_constraint(o);
+  });
+}
+
 void DiversityOptimizer::step_round_robin() {
   // A rollout depends on its sample alone and variation v's samples on its own CMA
   // instance alone, so every variation's samples of this generation are drawn and
   // simulated in one batch (N x lambda rollouts keep more workers busy than lambda). Only
   // the scoring depends on where the others stand: it runs variation by variation, each
   // against the moves of those before it, exactly as one batch per variation would.
-  std::vector<int> active;
-  std::vector<std::vector<Eigen::VectorXd>> xs(static_cast<std::size_t>(options_.variations) + 1);
-  std::vector<Eigen::VectorXd> batch;
-  std::vector<std::size_t> first(xs.size(), 0);
-  for (int v = 1; v <= options_.variations; ++v) {
-    if (cmas_[v - 1].stop_reason() != StopReason::kNone) continue;
-    active.push_back(v);
-    xs[v] = cmas_[v - 1].ask();
-    first[v] = batch.size();
-    batch.insert(batch.end(), xs[v].begin(), xs[v].end());
-  }
-  const auto outcomes = evaluate_all(batch, false);
-  for (int v : active) {
-    const auto begin = outcomes.begin() + static_cast<std::ptrdiff_t>(first[v]);
-    std::vector<std::shared_ptr<const Outcome>> own(begin, begin + static_cast<std::ptrdiff_t>(xs[v].size()));
+  Drawn g = draw_generation();
+  if (g.active.empty()) return;
+  const auto outcomes = evaluate_all(g.batch, false);
+  for (int v : g.active) {
+    const auto begin = outcomes.begin() + static_cast<std::ptrdiff_t>(g.first[v]);
+    std::vector<std::shared_ptr<const Outcome>> own(begin, begin + static_cast<std::ptrdiff_t>(g.xs[v].size()));
     // Tallied as the variation's step comes, so the log counts steps as it always did.
     for (const auto& outcome : own) problem_->tally(*outcome, ledger_);
-    evaluations_ += static_cast<long long>(xs[v].size());
-    move_to_best_sample(v, xs[v], own);
+    evaluations_ += static_cast<long long>(g.xs[v].size());
+    move_to_best_sample(v, g.xs[v], own);
   }
 }
 
@@ -536,11 +553,8 @@ void DiversityOptimizer::step_variation(int v) {
   }
 
   // Each sample replaces M_v in the current set and is ranked by its D and its own C.
-  std::vector<double> D(xs.size()), C(xs.size());
-  pool_->parallel_for(xs.size(), [&](std::size_t k, int) {
-    D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
-    C[k] = scored_constraint(*outcomes[k]);
-  });
+  std::vector<double> D, C;
+  score_against_current(v, outcomes, 0, xs.size(), C, D);
   count_samples(outcomes, xs.size());
   es.tell(fitness(C, D));
   // The new mean is what the other variations' samples are scored against from now on;
@@ -552,11 +566,8 @@ void DiversityOptimizer::step_variation(int v) {
 void DiversityOptimizer::move_to_best_sample(int v, const std::vector<Eigen::VectorXd>& xs,
                                              std::vector<std::shared_ptr<const Outcome>>& outcomes) {
   // Each sample replaces M_v in the current set and is ranked by its D and its own C.
-  std::vector<double> D(xs.size()), C(xs.size());
-  pool_->parallel_for(xs.size(), [&](std::size_t k, int) {
-    D[k] = replaced_objective(*problem_, outcomes_, current_, v, *outcomes[k], options_.k);
-    C[k] = scored_constraint(*outcomes[k]);
-  });
+  std::vector<double> D, C;
+  score_against_current(v, outcomes, 0, xs.size(), C, D);
   // M_v becomes this generation's best sample if it beats M_v as it stands, confirmed
   // (DiversityProblem::confirm) before it may; CMA-ES learns every confirmation's result.
   D.push_back(current_.D);
@@ -582,19 +593,12 @@ void DiversityOptimizer::count_samples(const std::vector<std::shared_ptr<const O
 }
 
 void DiversityOptimizer::step_simultaneous() {
-  const int n = options_.variations;
   // Every instance still running draws its generation; one batch holds them all.
-  std::vector<int> active;
-  std::vector<std::vector<Eigen::VectorXd>> xs(static_cast<std::size_t>(n) + 1);
-  std::vector<Eigen::VectorXd> batch;
-  std::vector<std::size_t> first(static_cast<std::size_t>(n) + 1, 0);
-  for (int v = 1; v <= n; ++v) {
-    if (cmas_[v - 1].stop_reason() != StopReason::kNone) continue;
-    active.push_back(v);
-    xs[v] = cmas_[v - 1].ask();
-    first[v] = batch.size();
-    batch.insert(batch.end(), xs[v].begin(), xs[v].end());
-  }
+  Drawn g = draw_generation();
+  const std::vector<int>& active = g.active;
+  const std::vector<std::vector<Eigen::VectorXd>>& xs = g.xs;
+  const std::vector<Eigen::VectorXd>& batch = g.batch;
+  const std::vector<std::size_t>& first = g.first;
   if (active.empty()) return;
   auto outcomes = evaluate_all(batch);
   evaluations_ += static_cast<long long>(batch.size());
@@ -629,12 +633,8 @@ void DiversityOptimizer::step_simultaneous() {
     // and the current set never gets worse. Costs distances only, no rollout.
     for (int v : active) {
       const std::size_t lambda = xs[v].size();
-      std::vector<double> Dv(lambda), Cv(lambda);
-      pool_->parallel_for(lambda, [&](std::size_t k, int) {
-        const Outcome& o = *outcomes[first[v] + k];
-        Dv[k] = replaced_objective(*problem_, outcomes_, current_, v, o, options_.k);
-        Cv[k] = scored_constraint(o);
-      });
+      std::vector<double> Dv, Cv;
+      score_against_current(v, outcomes, first[v], lambda, Cv, Dv);
       Dv.push_back(current_.D);
       Cv.push_back(current_.constraint[v]);
       const std::size_t best = choose_confirmed(v, xs[v], outcomes, first[v], Cv, Dv);

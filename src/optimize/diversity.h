@@ -288,10 +288,6 @@ class DiversityOptimizer {
   // on the pool; counted and tallied when `tally`.
   void confirm_all(const std::vector<Eigen::VectorXd>& xs,
                    std::vector<std::shared_ptr<const Outcome>>& outcomes, bool tally);
-  // best_candidate() over variation v's candidates outcomes[first..] (scored in C and D,
-  // the incumbent last), confirming the winner while it is provisional and choosing again
-  // with its final C and D (updated in C, D and outcomes) until the winner is confirmed
-  // or is the incumbent.
   // Confirmations run this many at a time (choose_confirmed); a constant, so that the
   // steps a run counts do not depend on its threads.
   static constexpr std::size_t kConfirmWidth = 2;
@@ -300,12 +296,30 @@ class DiversityOptimizer {
   std::vector<std::size_t> confirmation_order(const std::vector<std::shared_ptr<const Outcome>>& outcomes,
                                               std::size_t first, std::vector<double> C,
                                               std::vector<double> D, std::size_t width) const;
+  // best_candidate() over variation v's candidates outcomes[first..] (scored in C and D,
+  // the incumbent last), confirming the winner while it is provisional and choosing again
+  // with its final C and D (updated in C, D and outcomes) until the winner is confirmed
+  // or is the incumbent.
   std::size_t choose_confirmed(int v, const std::vector<Eigen::VectorXd>& xs,
                                std::vector<std::shared_ptr<const Outcome>>& outcomes,
                                std::size_t first, std::vector<double>& C, std::vector<double>& D);
   CmaesOptions cma_options(int dim, int instance) const;
   int present() const;  // motions in the current set, M_0 included
   void step_variation(int variation);  // one CMA generation of one variation
+  // A generation drawn by every CMA instance still running: its samples xs[v] (v = 1..N),
+  // all of them in one batch, variation v's from batch[first[v]].
+  struct Drawn {
+    std::vector<int> active;
+    std::vector<std::vector<Eigen::VectorXd>> xs;
+    std::vector<Eigen::VectorXd> batch;
+    std::vector<std::size_t> first;
+  };
+  Drawn draw_generation();
+  // C and D of the n samples outcomes[first..first + n), each in place of M_v in the
+  // current set, computed on the pool.
+  void score_against_current(int v, const std::vector<std::shared_ptr<const Outcome>>& outcomes,
+                             std::size_t first, std::size_t n, std::vector<double>& C,
+                             std::vector<double>& D) const;
   void step_round_robin();             // best-sample round-robin: one batch per generation
   // Scores variation v's samples xs (outcomes, tallied) against the current set, moves
   // M_v to the best if it beats M_v as it stands (confirmed first), tells CMA-ES.

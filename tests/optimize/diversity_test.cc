@@ -735,7 +735,9 @@ TEST_P(Confirmation, EveryVariationStandsOnlyWhereItsCheckHolds) {
   EXPECT_GT(opt.confirmations(), 0);
   EXPECT_EQ(opt.confirmations(), problem.confirmations.load());
   // (The joint strategy scores whole sets, so it confirms every provisional motion.)
-  if (GetParam() != DiversityStrategy::kJoint) EXPECT_LT(opt.confirmations(), feasible / 2);
+  if (GetParam() != DiversityStrategy::kJoint) {
+    EXPECT_LT(opt.confirmations(), feasible / 2);
+  }
   // Every evaluation and confirmation was tallied once.
   EXPECT_EQ(opt.ledger().value("total", 0LL), opt.evaluations() + opt.confirmations());
   EXPECT_EQ(opt.log().back().confirmations, opt.confirmations());
