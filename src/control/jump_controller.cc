@@ -82,6 +82,11 @@ ParamSpec pose_spec(int phase, const Character& body, const Layout& l, int group
   return {pose_name(phase, body, l, group), lo, hi, "rad"};
 }
 
+// With level_feet, the foot's world pitch in start, crouch and land is 0, not a parameter.
+bool level_foot(int phase, const JumpControllerConfig& config) {
+  return config.level_feet && (phase == kStart || phase == kCrouch || phase == kLand);
+}
+
 }  // namespace
 
 void append_jump_gain_specs(int phase, std::vector<ParamSpec>& specs) {
@@ -112,7 +117,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
           "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation", "stance_landing",
-          "stand_after", "stand_duration"});
+          "stand_after", "stand_duration", "level_feet"});
   auto c = std::make_shared<JumpControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -125,6 +130,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
   c->gravity_compensation = r.number("gravity_compensation", 0, 2, c->gravity_compensation);
   c->stance_landing = r.boolean("stance_landing", c->stance_landing);
+  c->level_feet = r.boolean("level_feet", c->level_feet);
   c->stand_after = r.number("stand_after", -1, 5, c->stand_after);
   c->stand_duration = r.number("stand_duration", 0.05, 5, c->stand_duration);
   if (c->stand_after >= 0 && !c->stance_landing) r.fail("stand_after", "expected stance_landing = true with it");
@@ -153,8 +159,10 @@ void JumpControllerType::check(const Character& body, const std::string& task_fi
 }
 
 std::vector<ParamSpec> JumpControllerType::parameter_specs(const Character& body,
-                                                           const ControllerConfig&) const {
-  return JumpController::parameter_specs(body);
+                                                           const ControllerConfig& config) const {
+  const auto* c = dynamic_cast<const JumpControllerConfig*>(&config);
+  if (c == nullptr) throw std::logic_error("jump2d: configuration of another controller");
+  return JumpController::parameter_specs(body, *c);
 }
 
 std::unique_ptr<Controller> JumpControllerType::make(const Character& body, const ControllerConfig& config,
@@ -169,11 +177,14 @@ std::unique_ptr<Controller> JumpControllerType::make(const Character& body, cons
 // ---------------------------------------------------------------------------------------
 // The controller.
 
-std::vector<ParamSpec> JumpController::parameter_specs(const Character& body) {
+std::vector<ParamSpec> JumpController::parameter_specs(const Character& body,
+                                                       const JumpControllerConfig& config) {
   const Layout l = layout_of(body);
   std::vector<ParamSpec> specs;
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (int g : l.posed) specs.push_back(pose_spec(p, body, l, g));
+    for (int g : l.posed) {
+      if (!(g == l.ankle && level_foot(p, config))) specs.push_back(pose_spec(p, body, l, g));
+    }
     append_jump_gain_specs(p, specs);
   }
   specs.push_back({"start.duration", 0.05, 0.6, "s"});
@@ -229,12 +240,17 @@ JumpController::JumpController(const Character& body, const JumpControllerConfig
 }
 
 void JumpController::set_parameters(const std::vector<double>& values) {
-  // Per phase a target per posed group and kp, kd of hip, knee, ankle; then six more.
-  const size_t count = kNumJumpPhases * (posed_.size() + 6) + 6;
+  // Per phase a target per posed group (but the level feet) and kp, kd of hip, knee,
+  // ankle; then six more.
+  size_t count = kNumJumpPhases * (posed_.size() + 6) + 6;
+  for (int p = 0; p < kNumJumpPhases; ++p) count -= level_foot(p, config_) ? 1 : 0;
   if (values.size() != count) throw std::logic_error("JumpController: parameter count");
   size_t k = 0;
   for (int p = 0; p < kNumJumpPhases; ++p) {
-    for (size_t g = 0; g < posed_.size(); ++g) pose_[p][g] = values[k++];
+    pose_[p].assign(posed_.size(), 0.0);  // a level foot: world pitch 0
+    for (size_t g = 0; g < posed_.size(); ++g) {
+      if (!(posed_[g] == ankle_ && level_foot(p, config_))) pose_[p][g] = values[k++];
+    }
     for (int j = 0; j < 3; ++j) {
       kp_[p][j] = values[k++];
       kd_[p][j] = values[k++];

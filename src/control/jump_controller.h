@@ -109,6 +109,11 @@ struct JumpControllerConfig : ControllerConfig {
   // < 0: hold the land pose.
   double stand_after = -1;
   double stand_duration = 0.5;  // s
+  // true: the soles stay level in start, crouch and land (the feet track world pitch 0;
+  // the pose's foot values of those phases are not parameters), so the character stands,
+  // crouches and lands flat-footed instead of balancing on a heel or toe edge, its support
+  // a point; the extend still pushes off from the toes. false: the paper's foot targets.
+  bool level_feet = false;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -132,10 +137,11 @@ class JumpController : public Controller {
  public:
   JumpController(const Character& body, const JumpControllerConfig& config);
 
-  // The free parameters for `body`: per phase a target per parameterized group and kp, kd
-  // of hips, knees and ankles; then durations and the landing and balance offsets (90 for
-  // the planar human).
-  static std::vector<ParamSpec> parameter_specs(const Character& body);
+  // The free parameters for `body`: per phase a target per parameterized group (but the
+  // level feet, with `config.level_feet`) and kp, kd of hips, knees and ankles; then
+  // durations and the landing and balance offsets (90 for the planar human, 87 with level
+  // feet).
+  static std::vector<ParamSpec> parameter_specs(const Character& body, const JumpControllerConfig& config);
   // Values in parameter_specs() order.
   void set_parameters(const std::vector<double>& values);
 

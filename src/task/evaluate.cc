@@ -23,6 +23,8 @@ class JumpHooks : public StepHooks {
       : task_(task), body_(body), controller_(controller), drive_(drive), obstacle_(obstacle_geom),
         end_when_decided_(end_when_decided), out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
         land_(controller.phase_times().land) {
+    const auto& names = controller.phase_times().names;
+    for (size_t i = 0; i < names.size(); ++i) if (names[i] == "extend") extend_ = static_cast<int>(i);
     out_.summary.min_clearance = task.simulation.clearance_range;
   }
 
@@ -107,6 +109,17 @@ class JumpHooks : public StepHooks {
       s.ended_decided = true;
       s.rotation_total = 2 * M_PI * c.rotation_turns;
       return true;
+    }
+
+    // A hop before the jump: off the ground in a phase before the extend.
+    if (task_.simulation.hop_is_fall && extend_ >= 0 && phase < extend_) {
+      if (contacts_.any) {
+        off_since_ = -1;
+      } else if (off_since_ < 0) {
+        off_since_ = t;
+      } else if (t - off_since_ >= 0.02 - 1e-9) {
+        return fall(t, "left the ground before the jump", d);
+      }
     }
 
     // Falls.
@@ -231,6 +244,8 @@ class JumpHooks : public StepHooks {
   Evaluation& out_;
   const int rise_, fall_, land_;  // the controller's airborne phases and landing
   ContactState contacts_;
+  int extend_ = -1;         // the controller's phase named "extend", -1 if none
+  double off_since_ = -1;   // before the extend: time the last contact was lost, -1 if touching
   void decide_if(bool cannot_meet) {
     if (cannot_meet && decided_ < 0) decided_ = index_;
   }

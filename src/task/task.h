@@ -100,6 +100,9 @@ struct TaskSimulation {
   double fall_tilt = 0;
   double clearance_range = 0.3;   // m: distance up to which obstacle proximity is seen
   double timestep = 0;            // s; > 0 overrides the model's timestep
+  // A jump whose character is off the ground for 20 ms or more before its extend phase
+  // (a hop before the jump) falls.
+  bool hop_is_fall = false;
 };
 
 struct TaskSeed {

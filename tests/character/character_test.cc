@@ -252,7 +252,7 @@ TEST(CharacterErrors, TheCommandLineSaysSoAndExitsWithTwo) {
   std::string text = read_text(std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml");
   text = edit(text, "character = \"../assets/characters/human2d.toml\"", "character = \"human2d.toml\"");
   text = edit(text, "m0 = \"jump_high.m0.json\"", "m0 = \"" + std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.m0.json\"");
-  text = edit(text, "base = \"base_jump.json\"", "base = \"" + std::string(DIVERSE_SOURCE_DIR) + "/tasks/base_jump.json\"");
+  text = edit(text, "base = \"jump_high_start.json\"", "base = \"" + std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high_start.json\"");
   write_text(task.string(), text);
   const cli_test::CliResult r = cli_test::run_cli("simulate " + task.string() + " --out " +
                                                   (fs::path(c.file()).parent_path() / "out").string());

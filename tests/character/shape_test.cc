@@ -716,7 +716,7 @@ TEST(ShapeBiped, VaryShapeOnACharacterWithoutShapeParametersIsOneLineWithExitCod
   const std::string tasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
   edit("character = \"../assets/characters/human2d.toml\"", "character = \"human2d.toml\"");
   edit("m0 = \"jump_high.m0.json\"", "m0 = \"" + tasks + "jump_high.m0.json\"");
-  edit("base = \"base_jump.json\"", "base = \"" + tasks + "base_jump.json\"");
+  edit("base = \"jump_high_start.json\"", "base = \"" + tasks + "jump_high_start.json\"");
   write_text((dir / "task.toml").string(), task);
   const fs::path out = dir / "out";
   const cli_test::CliResult r = cli_test::run_cli("run " + (dir / "task.toml").string() +

@@ -119,7 +119,7 @@ TEST(Parameters, FilesAreReadStrictly) {
 // The base jump runs the phases in order and keeps every joint torque within its limit.
 TEST(JumpController, PhasesInOrderTorquesWithinLimits) {
   const TaskEvaluator ev(load_task(kRoot + "/tasks/jump_high.toml"));
-  const ParameterSet p = ev.load_parameters(kRoot + "/tasks/base_jump.json");
+  const ParameterSet p = ev.load_parameters(kRoot + "/tasks/jump_high_start.json");
   auto worker = ev.make_worker();
   StepRecorder record;
   EvaluationOptions options;

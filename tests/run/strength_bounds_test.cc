@@ -167,7 +167,7 @@ std::string unchecked_task() {
   swap("half_timestep = true", "half_timestep = false");
   swap("\"../assets/", "\"" + kSource + "/assets/");
   swap("\"jump_high.m0.json\"", "\"" + kSource + "/tasks/jump_high.m0.json\"");
-  swap("\"base_jump.json\"", "\"" + kSource + "/tasks/base_jump.json\"");
+  swap("\"jump_high_start.json\"", "\"" + kSource + "/tasks/jump_high_start.json\"");
   const fs::path dir = test_files::scratch_dir("strength_bounds_task");
   fs::create_directories(dir);
   test_files::write_text((dir / "jump_high.toml").string(), toml);
@@ -177,7 +177,7 @@ std::string unchecked_task() {
 // A short real run's summary.
 nlohmann::json short_run(const fs::path& out, const std::string& extra) {
   static const std::string task = unchecked_task();
-  const auto r = run_cli("run " + task + " --n 2 --popsize 8 --sigma0 0.01 --generations 6 --seed 3 --threads 2 "
+  const auto r = run_cli("run " + task + " --n 2 --popsize 8 --sigma0 0.02 --generations 6 --seed 3 --threads 2 "
                          "--quiet --no-render --out " + out.string() + " " + extra);
   EXPECT_EQ(r.status, 0) << r.output;
   return read_json(out / "summary.json");

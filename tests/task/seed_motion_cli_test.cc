@@ -63,9 +63,9 @@ TEST(SeedMotionCli, EveryStageIsKeptAndASearchGoesOnFromALaterStage) {
   const fs::path dir = fs::temp_directory_path() / ("diverse_seed_motion_cli_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  // Stage 0 lands near where jump_high's input motion lands (0.13 m), which it meets at
-  // once; stage 1 asks for 1 m, which one generation does not reach.
-  write_forward_task(dir, "far", "tasks/jump_high.m0.json", "distances = [0.1, 1.0]\n");
+  // Stage 0 lands near where jump_high's earlier input motion lands (0.13 m), which it
+  // meets at once; stage 1 asks for 1 m, which one generation does not reach.
+  write_forward_task(dir, "far", "tests/task/data/jump_high_paper_feet.m0.json", "distances = [0.1, 1.0]\n");
   const std::string task = (dir / "far.toml").string();
   const auto first = cli_test::run_cli("seed-motion " + task + " --threads 2");
   EXPECT_NE(first.status, 0) << first.output;
@@ -166,18 +166,26 @@ TEST(SeedMotionCli, RobustSearchWritesOnlyAMotionThatHoldsTheSuitesPart) {
 }
 
 // A candidate that meets the task but fails the suite's part is never written as the m0:
-// jump_high's input motion (which does not hold the part) and candidates a millionth of
-// the ranges around it, some of which meet the task, go to the partial file, and the hint
-// to go on keeps --robust. Without --robust the same search writes the m0.
+// jump_high's earlier input motion (found under the paper's foot targets, with a hop before
+// the jump allowed: tests/task/data/jump_high_paper_feet.m0.json), which does not hold the part, and
+// candidates a millionth of the ranges around it, some of which meet the task, go to the
+// partial file, and the hint to go on keeps --robust. Without --robust the same search
+// writes the m0.
 TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
   const fs::path dir = test_files::scratch_dir("seed_motion_cli_test_fails_part");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path task = copy_task(dir, "jump_high", "popsize = 6\n");
+  {
+    std::string t = read_file(task.string());
+    t = std::regex_replace(t, std::regex("\nlevel_feet = true"), "\nlevel_feet = false");
+    t = std::regex_replace(t, std::regex("\nhop_is_fall = true"), "\nhop_is_fall = false");
+    write_file_atomic(task, t);
+  }
   const TaskEvaluator ev(load_task(task.string()));
-  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.m0.json";
+  const std::string start = std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_high_paper_feet.m0.json";
   ASSERT_FALSE(check_suite(ev, ev.load_parameters(start), robust_sample_suite()).holds)
-      << "jump_high's input motion holds the suite's part now: this test needs one that does not";
+      << "jump_high's earlier input motion holds the suite's part now: this test needs one that does not";
   const std::string args = "seed-motion " + task.string() + " --start " + start + " --generations 1 --sigma 1e-6 --threads 2";
   const fs::path m0 = dir / "jump_high.m0.json", partial = dir / "jump_high.partial.json";
 
