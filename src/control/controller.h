@@ -49,6 +49,8 @@ struct PhaseTimes {
   std::vector<double> begin;       // one per phase
   // The airborne phases of a jump: [takeoff, peak) and [peak, landing). -1 if none.
   int rise = -1, fall = -1, land = -1;
+  // The phase that pushes off the ground (a jump's extend); the phases before it stand.
+  int extend = -1;
   double at(int phase) const { return phase >= 0 ? begin[static_cast<size_t>(phase)] : -1; }
   double takeoff() const { return at(rise); }
   double peak() const { return at(fall); }

@@ -280,6 +280,7 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
   qpos0_.assign(n, 0.0);
   times_.names = jump_phase_names();
   times_.begin.assign(kNumJumpPhases, -1.0);
+  times_.extend = kExtend;
   times_.rise = kRise;
   times_.fall = kFall;
   times_.land = kLand;

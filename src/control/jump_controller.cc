@@ -234,6 +234,7 @@ JumpController::JumpController(const Character& body, const JumpControllerConfig
   balance_.assign(body.joints.size(), 0.0);
   times_.names = jump_phase_names();
   times_.begin.assign(kNumJumpPhases, -1.0);
+  times_.extend = kExtend;
   times_.rise = kRise;
   times_.fall = kFall;
   times_.land = kLand;

@@ -22,9 +22,7 @@ class JumpHooks : public StepHooks {
             int obstacle_geom, bool end_when_decided, Evaluation& out)
       : task_(task), body_(body), controller_(controller), drive_(drive), obstacle_(obstacle_geom),
         end_when_decided_(end_when_decided), out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
-        land_(controller.phase_times().land) {
-    const auto& names = controller.phase_times().names;
-    for (size_t i = 0; i < names.size(); ++i) if (names[i] == "extend") extend_ = static_cast<int>(i);
+        land_(controller.phase_times().land), extend_(controller.phase_times().extend) {
     out_.summary.min_clearance = task.simulation.clearance_range;
   }
 
@@ -243,8 +241,8 @@ class JumpHooks : public StepHooks {
   bool end_when_decided_;
   Evaluation& out_;
   const int rise_, fall_, land_;  // the controller's airborne phases and landing
+  const int extend_;              // its push-off phase (-1: none)
   ContactState contacts_;
-  int extend_ = -1;         // the controller's phase named "extend", -1 if none
   double off_since_ = -1;   // before the extend: time the last contact was lost, -1 if touching
   void decide_if(bool cannot_meet) {
     if (cannot_meet && decided_ < 0) decided_ = index_;
