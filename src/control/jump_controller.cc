@@ -117,7 +117,8 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
           "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation", "stance_landing",
-          "stand_after", "stand_duration", "level_feet"});
+          "stand_after", "stand_duration", "level_feet", "landing_reach",
+          "landing_at_touchdown"});
   auto c = std::make_shared<JumpControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -131,6 +132,8 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->gravity_compensation = r.number("gravity_compensation", 0, 2, c->gravity_compensation);
   c->stance_landing = r.boolean("stance_landing", c->stance_landing);
   c->level_feet = r.boolean("level_feet", c->level_feet);
+  c->landing_reach = r.number("landing_reach", 0, 1, c->landing_reach);
+  c->landing_at_touchdown = r.boolean("landing_at_touchdown", c->landing_at_touchdown);
   c->stand_after = r.number("stand_after", -1, 5, c->stand_after);
   c->stand_duration = r.number("stand_duration", 0.05, 5, c->stand_duration);
   if (c->stand_after >= 0 && !c->stance_landing) r.fail("stand_after", "expected stance_landing = true with it");
@@ -283,6 +286,11 @@ void JumpController::reset(const mjModel* m, const mjData* d) {
   takeoff_com_z_ = 0;
   free_since_ = -1;
   if (config_.stance_landing) stance_ = std::make_unique<StanceController>(body_, m);
+  // Standing: the COM's height above the floor, and how far ahead of the ankle each sole's
+  // middle (the foot's centre of mass) lies.
+  standing_com_z_ = d->subtree_com[3 * body_.root_body + 2];
+  sole_ahead_ = 0;
+  for (int f : body_.feet) sole_ahead_ += 0.5 * (d->xipos[3 * f] - d->xpos[3 * f]);
 }
 
 void JumpController::enter(int phase, double time) {
@@ -401,12 +409,17 @@ double JumpController::to_world(int j, const double* q, double local) const {
 double JumpController::landing_hip_goal(int j, const mjData* d) const {
   const CharacterJoint& hip = body_.joints[static_cast<size_t>(j)];
   const int side = side_[static_cast<size_t>(j)];
-  // Where the COM crosses the landing surface on its ballistic path.
-  const double z = std::max(com_[2] - config_.landing_height_m, 0.0);
+  // The paper's: where the COM crosses the landing surface on its ballistic path.
+  // landing_at_touchdown: where the COM will be when it has come down to its standing
+  // height above the surface (about when the feet touch), less the sole's middle's lead
+  // over the ankle, so that with offset and gain 0 the COM comes down over the soles.
+  const double above = config_.landing_at_touchdown ? standing_com_z_ : 0.0;
+  const double z = std::max(com_[2] - config_.landing_height_m - above, 0.0);
   const double vz = com_vel_[2];
   const double t_cross = (vz + std::sqrt(vz * vz + 2 * gravity_ * z)) / gravity_;
-  const double x_target =
-      com_[0] + com_vel_[0] * t_cross + landing_offset_ + landing_velocity_gain_ * com_vel_[0];
+  const double sole = config_.landing_at_touchdown ? sole_ahead_ : 0.0;
+  const double x_target = com_[0] + com_vel_[0] * t_cross - sole + landing_offset_ +
+                          landing_velocity_gain_ * com_vel_[0];
   const double dx = x_target - d->xanchor[3 * hip.joint];
   // Two-link leg: ankle x offset = l1 sin(th) + l2 sin(th + qk) = R sin(th + psi).
   const int knee = body_.groups[static_cast<size_t>(knee_)].joints[static_cast<size_t>(side)];
@@ -492,7 +505,8 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
     for (int i : body_.groups[static_cast<size_t>(hip_)].joints) {
       double goal = pose_hip;
       if (w > 0) goal = (1 - w) * goal + w * landing_hip_goal(i, d);
-      target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + s * (goal - from_[static_cast<size_t>(i)]);
+      const double sh = config_.landing_reach > 0 ? std::min(1.0, (t - phase_begin_) / config_.landing_reach) : s;
+      target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + sh * (goal - from_[static_cast<size_t>(i)]);
     }
   }
 

@@ -50,7 +50,12 @@
 // x_c + landing.offset + landing.velocity_gain * v_x, where x_c is where the COM is
 // predicted to cross the landing surface ballistically; the hip angle comes from the
 // two-link leg geometry (hip-knee and knee-ankle distances of the standing model) with
-// the knee at its phase target.
+// the knee at its phase target. With landing_at_touchdown, x_c is where the COM will be when
+// it has come down to its standing height above the surface, less the soles' lead over the
+// ankles, so the COM comes down over the middle of the soles (the paper's x_c, where the
+// COM would reach the surface itself, overshoots, and the optimized offset that makes up
+// for it holds only for the pitch the input motion lands with); with landing_reach the
+// hips reach that goal within landing_reach seconds of the peak and then follow it.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -114,6 +119,16 @@ struct JumpControllerConfig : ControllerConfig {
   // crouches and lands flat-footed instead of balancing on a heel or toe edge, its support
   // a point; the extend still pushes off from the toes. false: the paper's foot targets.
   bool level_feet = false;
+  // s; > 0 (with landing_control): the hips reach the landing controller's goal this long
+  // after the fall begins and then follow it, so the feet go where the COM will come down
+  // whatever the pose at the peak; 0: the paper's, the goal reached over the whole fall.
+  double landing_reach = 0;
+  // true (with landing_control): the landing controller aims the ankles where the COM
+  // will be at touch-down (when it has come down to its standing height above the landing
+  // surface) less the sole's lead over the ankle, so landing.offset and velocity_gain are
+  // corrections to a COM over the middle of the soles; false: the paper's, where the COM
+  // would cross the landing surface itself.
+  bool landing_at_touchdown = false;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -205,6 +220,8 @@ class JumpController : public Controller {
   std::unique_ptr<StanceController> stance_;
   std::array<double, 3> land_from_{}, land_goal_{};
   double gravity_ = 9.81;
+  double standing_com_z_ = 0;  // m, the COM's height at reset()
+  double sole_ahead_ = 0;      // m, the soles' middles ahead of the ankles at reset()
 };
 
 }  // namespace diverse

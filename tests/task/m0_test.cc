@@ -77,7 +77,7 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"jump_forward", {0.01, 32, 12}},
     {"jump_onto", {0.01, 32, 5}},
     {"jump_over", {0.002, 32, 3}},
-    {"jump_high", {0.02, 32, 10}},
+    {"jump_high", {0.02, 32, 20}},
     // The 3D jumps: perturbed on both sides apart (their tasks' `asymmetric = true`) and
     // judged at half the timestep too; robot_jump's M0 has no such neighbour that meets
     // its task (0 of 32 at sigma 0.005, docs/jumps3d.md), so it has no bound here.

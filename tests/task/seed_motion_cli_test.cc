@@ -166,7 +166,7 @@ TEST(SeedMotionCli, RobustSearchWritesOnlyAMotionThatHoldsTheSuitesPart) {
 }
 
 // A candidate that meets the task but fails the suite's part is never written as the m0:
-// jump_high's earlier input motion (found under the paper's foot targets, with a hop before
+// jump_high's earlier input motion (found under the paper's foot targets and landing aim, with a hop before
 // the jump allowed: tests/task/data/jump_high_paper_feet.m0.json), which does not hold the part, and
 // candidates a millionth of the ranges around it, some of which meet the task, go to the
 // partial file, and the hint to go on keeps --robust. Without --robust the same search
@@ -180,6 +180,8 @@ TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
     std::string t = read_file(task.string());
     t = std::regex_replace(t, std::regex("\nlevel_feet = true"), "\nlevel_feet = false");
     t = std::regex_replace(t, std::regex("\nhop_is_fall = true"), "\nhop_is_fall = false");
+    t = std::regex_replace(t, std::regex("\nlanding_at_touchdown = true"), "\nlanding_at_touchdown = false");
+    t = std::regex_replace(t, std::regex("\nlanding_reach = [0-9.]+"), "\nlanding_reach = 0");
     write_file_atomic(task, t);
   }
   const TaskEvaluator ev(load_task(task.string()));
