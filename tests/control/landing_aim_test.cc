@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <random>
 #include <string>
 
@@ -21,6 +20,7 @@
 #include "physics/rollout.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "support/task_variant.h"
 
 namespace diverse {
 namespace {
@@ -29,29 +29,10 @@ namespace fs = std::filesystem;
 const std::string kSource = DIVERSE_SOURCE_DIR;
 
 // jump_high.toml with its landing_at_touchdown and landing_reach lines replaced by
-// `controller` (top of [controller]), in a scratch directory.
+// `controller` (top of [controller]).
 fs::path variant(const std::string& name, const std::string& controller) {
-  std::ifstream in(kSource + "/tasks/jump_high.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const char* key : {"landing_at_touchdown =", "landing_reach ="}) {
-    const auto at = text.find(std::string("\n") + key);
-    if (at == std::string::npos) throw std::runtime_error(std::string("jump_high.toml has no ") + key);
-    text.erase(at + 1, text.find('\n', at + 1) - at);
-  }
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("jump_high.toml has no " + from);
-    text.replace(at, from.size(), to);
-  };
-  replace("character = \"../", "character = \"" + kSource + "/");
-  replace("m0 = \"", "m0 = \"" + kSource + "/tasks/");
-  replace("base = \"", "base = \"" + kSource + "/tasks/");
-  replace("[controller]\n", "[controller]\n" + controller + "\n");
-  const fs::path dir = fs::temp_directory_path() / "diverse_landing_aim";
-  fs::create_directories(dir);
-  const fs::path file = dir / (name + ".toml");
-  std::ofstream(file) << text;
-  return file;
+  return test_files::task_variant("jump_high", "landing_aim_" + name, {"landing_at_touchdown =", "landing_reach ="},
+                                  {{"controller", controller}});
 }
 
 // The COM's horizontal distance ahead of the middle of the soles (the feet's centres of

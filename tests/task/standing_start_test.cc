@@ -11,7 +11,6 @@
 
 #include <filesystem>
 #include <algorithm>
-#include <fstream>
 #include <string>
 
 #include "control/jump_controller.h"
@@ -19,6 +18,7 @@
 #include "physics/rollout.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "support/task_variant.h"
 
 namespace diverse {
 namespace {
@@ -28,31 +28,12 @@ const std::string kSource = DIVERSE_SOURCE_DIR;
 const std::string kHops = kSource + "/tests/task/data/jump_high_paper_feet.m0.json";
 
 // jump_high.toml with its own level_feet and hop_is_fall lines replaced by `controller`
-// (top of [controller]) and `simulation` (top of [simulation]), in a scratch directory;
-// the landing aim is the paper's, as the earlier input motion was found with it.
+// (top of [controller]) and `simulation` (top of [simulation]); the landing aim is the
+// paper's, as the earlier input motion was found with it.
 fs::path variant(const std::string& name, const std::string& controller, const std::string& simulation) {
-  std::ifstream in(kSource + "/tasks/jump_high.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  for (const char* key : {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach ="}) {
-    for (auto at = text.find(std::string("\n") + key); at != std::string::npos; at = text.find(std::string("\n") + key))
-      text.erase(at + 1, text.find('\n', at + 1) - at);
-  }
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("jump_high.toml has no " + from);
-    text.replace(at, from.size(), to);
-  };
-  replace("character = \"../", "character = \"" + kSource + "/");
-  replace("m0 = \"", "m0 = \"" + kSource + "/tasks/");
-  replace("base = \"", "base = \"" + kSource + "/tasks/");
-  replace("[controller]\n", "[controller]\n" + controller + "\n");
-  if (text.find("\n[simulation]\n") == std::string::npos) text += "\n[simulation]\n";
-  replace("\n[simulation]\n", "\n[simulation]\n" + simulation + "\n");
-  const fs::path dir = fs::temp_directory_path() / "diverse_standing_start";
-  fs::create_directories(dir);
-  const fs::path file = dir / (name + ".toml");
-  std::ofstream(file) << text;
-  return file;
+  return test_files::task_variant("jump_high", "standing_start_" + name,
+                                  {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach ="},
+                                  {{"controller", controller}, {"simulation", simulation}});
 }
 
 struct Footing {
