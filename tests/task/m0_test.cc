@@ -74,7 +74,7 @@ struct Neighbourhood {
 };
 const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"backflip", {0.0005, 32, 3}},
-    {"jump_forward", {0.01, 32, 12}},
+    {"jump_forward", {0.02, 32, 14}},
     {"jump_onto", {0.01, 32, 5}},
     {"jump_over", {0.002, 32, 3}},
     {"jump_high", {0.02, 32, 20}},
