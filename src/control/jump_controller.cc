@@ -505,8 +505,9 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
     for (int i : body_.groups[static_cast<size_t>(hip_)].joints) {
       double goal = pose_hip;
       if (w > 0) goal = (1 - w) * goal + w * landing_hip_goal(i, d);
-      const double sh = config_.landing_reach > 0 ? std::min(1.0, (t - phase_begin_) / config_.landing_reach) : s;
-      target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + sh * (goal - from_[static_cast<size_t>(i)]);
+      // How far along from the peak's hip angle to the goal (landing_reach: reached early).
+      const double along = config_.landing_reach > 0 ? std::min(1.0, (t - phase_begin_) / config_.landing_reach) : s;
+      target_[static_cast<size_t>(i)] = from_[static_cast<size_t>(i)] + along * (goal - from_[static_cast<size_t>(i)]);
     }
   }
 
