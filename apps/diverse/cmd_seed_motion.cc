@@ -291,7 +291,8 @@ void install(CLI::App& app) {
   cmd->add_flag("--robustness-check", args->robustness_check,
                 "Measure a motion instead of searching (default: the task's M0, or --start)");
   cmd->add_option("--check-sigmas", args->check_sigmas,
-                  "Robustness check: perturbation sizes, normalized (default 0.02 0.05)")
+                  "Robustness check: perturbation sizes, normalized (default 0.02 0.05); each size "
+                  "gets the same perturbations whatever the others")
       ->check(number_in(1e-6, 1.0));
   cmd->add_option("--check-samples", args->check_samples,
                   "Robustness check: perturbations per size (default 32)")

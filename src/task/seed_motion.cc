@@ -1,6 +1,7 @@
 #include "task/seed_motion.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -397,6 +398,10 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
   return out;
 }
 
+std::uint64_t robustness_seed(const Task& task, double sigma) {
+  return derive_seed(task.seed.seed, {kMeasurePerturbations, std::bit_cast<std::uint64_t>(sigma)});
+}
+
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
                                     const std::vector<double>& sigmas, int samples, int threads) {
   const TaskEvaluator ev(task);
@@ -416,9 +421,7 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
   report.landing_shift = both_landed(coarse, fine_e) ? landing_shift(coarse.summary, fine_e.summary)
                                                      : std::numeric_limits<double>::quiet_NaN();
   for (size_t level = 0; level < sigmas.size(); ++level) {
-    const std::vector<Eigen::VectorXd> xs =
-        perturb(x, sigmas[level], samples,
-                derive_seed(task.seed.seed, {kMeasurePerturbations, static_cast<std::uint64_t>(level)}));
+    const std::vector<Eigen::VectorXd> xs = perturb(x, sigmas[level], samples, robustness_seed(task, sigmas[level]));
     // Meeting the task as the diversity optimizer judges it: with the half-timestep check
     // where the task asks for it.
     EvaluationOptions perturbed = options;
@@ -431,6 +434,7 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
     l.sigma = sigmas[level];
     l.samples = samples;
     l.met = static_cast<int>(std::count(c.begin(), c.end(), 0.0));
+    l.constraints = std::move(c);
     report.levels.push_back(l);
   }
   return report;

@@ -141,8 +141,8 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
                                      std::uint64_t seed);
 
 // How much of a motion's neighbourhood meets the task: C at the task's timestep and with
-// it halved, and, for each sigma, how many of `samples` perturbations (perturb() with the
-// task's seed.seed) meet the task as the diversity optimizer judges it: C = 0 at the
+// it halved, and, for each sigma, how many of `samples` perturbations (perturb() with
+// robustness_seed()) meet the task as the diversity optimizer judges it: C = 0 at the
 // task's timestep, and with the half-timestep check where the task asks for it.
 struct RobustnessReport {
   double constraint = 0;       // C at the task's timestep
@@ -152,11 +152,17 @@ struct RobustnessReport {
     double sigma = 0;  // normalized
     int samples = 0;
     int met = 0;       // perturbations with C = 0
+    std::vector<double> constraints;  // C of each perturbation, in perturb()'s order
     double fraction() const { return samples > 0 ? static_cast<double>(met) / samples : 0; }
   };
   std::vector<Level> levels;
 };
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
                                     const std::vector<double>& sigmas, int samples, int threads);
+
+// The seed of measure_robustness()'s perturbations at `sigma`: from the task's seed.seed
+// and the value of sigma alone, so a sigma gets the same perturbations whatever other
+// sigmas are measured with it, in whatever order.
+std::uint64_t robustness_seed(const Task& task, double sigma);
 
 }  // namespace diverse

@@ -78,6 +78,26 @@ TEST(Robustness, TellsAMotionsNeighbourhoodFromRandomControllers) {
   EXPECT_EQ(r.levels[1].fraction(), 0.0);
 }
 
+// A sigma's perturbations do not depend on the other sigmas measured with it: the same
+// 8 constraint values at 0.03 alone, after another sigma, and in another order. (They once
+// came from the sigma's index in the list, so `--check-sigmas 0.01 0.02` and
+// `--check-sigmas 0.005 0.01 0.02` reported different counts at 0.02.)
+TEST(Robustness, ASigmasPerturbationsDoNotDependOnTheOtherSigmas) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  const RobustnessReport alone = measure_robustness(task, m0, {0.03}, 8, 2);
+  const RobustnessReport after = measure_robustness(task, m0, {0.005, 0.03}, 8, 2);
+  const RobustnessReport before = measure_robustness(task, m0, {0.03, 0.005}, 8, 2);
+  ASSERT_EQ(alone.levels[0].constraints.size(), 8u);
+  EXPECT_EQ(after.levels[1].constraints, alone.levels[0].constraints);
+  EXPECT_EQ(before.levels[0].constraints, alone.levels[0].constraints);
+  EXPECT_EQ(after.levels[0].constraints, before.levels[1].constraints);
+  // and they are samples of a neighbourhood, not one repeated point
+  EXPECT_NE(alone.levels[0].constraints, std::vector<double>(8, alone.levels[0].constraints[0]));
+  EXPECT_NE(robustness_seed(task, 0.03), robustness_seed(task, 0.02));
+}
+
 // A perturbation meets the task as the diversity optimizer judges it: where the task has
 // the half-timestep check, one that meets it at 2 ms but lands elsewhere (or falls) at 1 ms
 // does not count. The high jump's input motion with the paper's foot targets lands 2.0 cm apart at the two timesteps
