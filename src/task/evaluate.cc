@@ -130,6 +130,22 @@ class JumpHooks : public StepHooks {
       if (task_.simulation.fall_tilt > 0 && tilt(d, pitch) > task_.simulation.fall_tilt) {
         return fall(t, "the body tipped over", d);
       }
+      // A topple: both feet down, past the landing's first topple_after seconds, and the
+      // COM and its capture point both topple_distance outside the soles.
+      const TaskSimulation& rules = task_.simulation;
+      if (rules.topple_distance > 0 && s.landed && contacts_.foot[0] && contacts_.foot[1] &&
+          t - controller_.phase_times().landing() >= rules.topple_after - 1e-9) {
+        const auto& x = controller_.com();
+        const auto& v = controller_.com_velocity();
+        const double g = std::max(1e-9, std::fabs(m->opt.gravity[2]));
+        const double tc = std::sqrt(std::max(0.0, x[2] - feet_z) / g);
+        if (sole_margin(m, d, body_, contacts_, {x[0], x[1]}) < -rules.topple_distance &&
+            sole_margin(m, d, body_, contacts_, {x[0] + v[0] * tc, x[1] + v[1] * tc}) < -rules.topple_distance) {
+          // Ranked as the fall it would become: most topples lie on the ground a second
+          // or more after touch-down, where a fall's progress is full.
+          return fall(t, "toppled over the edge of the feet", d, /*landed_fully=*/true);
+        }
+      }
     }
 
     // End of the motion.
@@ -210,11 +226,14 @@ class JumpHooks : public StepHooks {
     return free_pitch_;
   }
 
-  bool fall(double t, const char* why, const mjData* d) {
+  // `landed_fully`: the fall's progress is that of a fall settle_time or more after
+  // touch-down, whenever it is called.
+  bool fall(double t, const char* why, const mjData* d, bool landed_fully = false) {
     MotionSummary& s = out_.summary;
     s.fell = true;
     s.fall_reason = why;
-    s.fall_progress = progress(t);
+    s.fall_progress = landed_fully ? (land_ + 1.0) / static_cast<double>(controller_.phase_times().begin.size())
+                                   : progress(t);
     return finish(t, d);
   }
 

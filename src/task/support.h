@@ -15,6 +15,7 @@
 #include <array>
 
 #include "character/character.h"
+#include "control/controller.h"
 
 namespace diverse {
 
@@ -24,5 +25,15 @@ namespace diverse {
 // root's the convex hull of their horizontal positions. -infinity without a foot contact.
 double capture_point_margin(const mjModel* m, const mjData* d, const Character& body,
                             const std::array<double, 3>& com, const std::array<double, 3>& com_velocity);
+
+// The signed distance (m) from the horizontal point `p` to the edge of the soles of the
+// feet that touch the ground (`contacts`): their whole outline, not just the points that
+// touch now, so a foot landing on its heel supports the COM over its middle. The outline
+// is each foot geom's horizontal extent: a capsule's axis end points lengthened by its
+// radius, a box's corners, a sphere's centre and radius along x and y. A planar
+// character's support is the outline's x-interval; a free root's its convex hull.
+// -infinity without a foot on the ground.
+double sole_margin(const mjModel* m, const mjData* d, const Character& body, const ContactState& contacts,
+                   const std::array<double, 2>& p);
 
 }  // namespace diverse

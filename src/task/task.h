@@ -103,6 +103,19 @@ struct TaskSimulation {
   // A jump whose character is off the ground for 20 ms or more before its extend phase
   // (a hop before the jump) falls.
   bool hop_is_fall = false;
+  // m; > 0: from topple_after seconds after touch-down, with both feet on the ground,
+  // the COM and its capture point (task/support.h) both more than this outside the soles
+  // (sole_margin(), the feet's whole outline) is a fall ("toppled over the edge of the
+  // feet"), ranked as a fall a second or more after touch-down: with no foot left to
+  // step with, a body seldom brings back a COM that has left its soles that far and is
+  // still moving away; without the rule it is simulated until it lies on the ground,
+  // about a second later. The landing's first topple_after seconds are left out: a
+  // landing's impact and the swing of the upper body that catches it can carry both
+  // points out and back (jump_over's landings do even later, and the backflip's within
+  // 0.4 s: docs/scaling.md, "Where a rollout ends"). 0: not checked (every committed
+  // task; docs/results.md, "Ending topples").
+  double topple_distance = 0;
+  double topple_after = 0.2;  // s
 };
 
 struct TaskSeed {

@@ -228,7 +228,9 @@ TEST(Suite, RecordsEachDrawsParametersAndWhenAFallCame) {
       EXPECT_LE(r["fell_after_touchdown"].get<double>(), f.ev.task().simulation.settle_max + 1e-9);
     }
     for (const nlohmann::json& r : j["motions"][0]["kinds"][kind]["rollouts"]) {
-      if (r["holds"].get<bool>()) EXPECT_FALSE(r.contains("fell_after_touchdown")) << r.dump();
+      if (r["holds"].get<bool>()) {
+        EXPECT_FALSE(r.contains("fell_after_touchdown")) << r.dump();
+      }
     }
   }
   EXPECT_GT(falls_after_landing, 0);
