@@ -139,8 +139,9 @@ class JumpHooks : public StepHooks {
         const auto& v = controller_.com_velocity();
         const double g = std::max(1e-9, std::fabs(m->opt.gravity[2]));
         const double tc = std::sqrt(std::max(0.0, x[2] - feet_z) / g);
-        if (sole_margin(m, d, body_, contacts_, {x[0], x[1]}) < -rules.topple_distance &&
-            sole_margin(m, d, body_, contacts_, {x[0] + v[0] * tc, x[1] + v[1] * tc}) < -rules.topple_distance) {
+        const SoleOutline soles = sole_outline(m, d, body_, contacts_);
+        if (soles.margin({x[0], x[1]}) < -rules.topple_distance &&
+            soles.margin({x[0] + v[0] * tc, x[1] + v[1] * tc}) < -rules.topple_distance) {
           // Ranked as the fall it would become: most topples lie on the ground a second
           // or more after touch-down, where a fall's progress is full.
           return fall(t, "toppled over the edge of the feet", d, /*landed_fully=*/true);

@@ -41,8 +41,7 @@ double capture_point_margin(const mjModel* m, const mjData* d, const Character& 
   return polygon_margin(convex_hull(std::move(points)), cp);
 }
 
-double sole_margin(const mjModel* m, const mjData* d, const Character& body, const ContactState& contacts,
-                   const std::array<double, 2>& p) {
+SoleOutline sole_outline(const mjModel* m, const mjData* d, const Character& body, const ContactState& contacts) {
   std::vector<Vec2> points;
   for (int g = 0; g < m->ngeom; ++g) {
     int foot = -1;
@@ -51,18 +50,20 @@ double sole_margin(const mjModel* m, const mjData* d, const Character& body, con
     const double* R = d->geom_xmat + 9 * g;  // columns: the geom's axes in the world
     const double* size = m->geom_size + 3 * g;
     const int type = m->geom_type[g];
+    auto square = [&](double r) {
+      for (int c = 0; c < 4; ++c) points.push_back({x[0] + (c & 1 ? 1 : -1) * r, x[1] + (c & 2 ? 1 : -1) * r});
+    };
     if (type == mjGEOM_CAPSULE || type == mjGEOM_CYLINDER) {
-      // The axis (local z) projected on the ground, lengthened by the radius each way.
+      // The axis (local z) projected on the ground, lengthened by the radius each way: a
+      // capsule reaches size[1] |axis_xy| + radius from its centre along it.
       const double ax = R[2], ay = R[5];
       const double flat = std::hypot(ax, ay);
       const double stretch = type == mjGEOM_CAPSULE && flat > 1e-9 ? size[0] / flat : 0;
       for (double end : {-1.0, 1.0}) {
-        const double k = end * (size[1] + stretch);  // horizontally size[1] flat + radius
+        const double k = end * (size[1] + stretch);
         points.push_back({x[0] + k * ax, x[1] + k * ay});
       }
-      if (type == mjGEOM_CYLINDER || flat <= 1e-9) {
-        for (int c = 0; c < 4; ++c) points.push_back({x[0] + (c & 1 ? 1 : -1) * size[0], x[1] + (c & 2 ? 1 : -1) * size[0]});
-      }
+      if (type == mjGEOM_CYLINDER || flat <= 1e-9) square(size[0]);
     } else if (type == mjGEOM_BOX) {
       for (int c = 0; c < 8; ++c) {
         const double l[3] = {(c & 1 ? 1 : -1) * size[0], (c & 2 ? 1 : -1) * size[1], (c & 4 ? 1 : -1) * size[2]};
@@ -71,20 +72,25 @@ double sole_margin(const mjModel* m, const mjData* d, const Character& body, con
         points.push_back({x[0] + w[0], x[1] + w[1]});
       }
     } else {
-      const double r = type == mjGEOM_SPHERE ? size[0] : m->geom_rbound[g];
-      for (int c = 0; c < 4; ++c) points.push_back({x[0] + (c & 1 ? 1 : -1) * r, x[1] + (c & 2 ? 1 : -1) * r});
+      square(type == mjGEOM_SPHERE ? size[0] : m->geom_rbound[g]);
     }
   }
-  if (points.empty()) return -std::numeric_limits<double>::infinity();
-  if (body.root == RootKind::kPlanar) {
-    double lo = points[0][0], hi = points[0][0];
-    for (const Vec2& q : points) {
-      lo = std::min(lo, q[0]);
-      hi = std::max(hi, q[0]);
+  SoleOutline out;
+  out.planar = body.root == RootKind::kPlanar;
+  if (out.planar) {
+    for (size_t i = 0; i < points.size(); ++i) {
+      out.lo = i == 0 ? points[i][0] : std::min(out.lo, points[i][0]);
+      out.hi = i == 0 ? points[i][0] : std::max(out.hi, points[i][0]);
     }
-    return std::min(p[0] - lo, hi - p[0]);
+  } else {
+    out.hull = convex_hull(std::move(points));
   }
-  return polygon_margin(convex_hull(std::move(points)), {p[0], p[1]});
+  return out;
+}
+
+double SoleOutline::margin(const Vec2& p) const {
+  if (planar) return lo <= hi ? std::min(p[0] - lo, hi - p[0]) : -std::numeric_limits<double>::infinity();
+  return polygon_margin(hull, p);  // -infinity for an empty hull
 }
 
 }  // namespace diverse

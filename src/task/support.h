@@ -13,9 +13,11 @@
 #include <mujoco/mujoco.h>
 
 #include <array>
+#include <vector>
 
 #include "character/character.h"
 #include "control/controller.h"
+#include "core/polygon.h"
 
 namespace diverse {
 
@@ -26,14 +28,19 @@ namespace diverse {
 double capture_point_margin(const mjModel* m, const mjData* d, const Character& body,
                             const std::array<double, 3>& com, const std::array<double, 3>& com_velocity);
 
-// The signed distance (m) from the horizontal point `p` to the edge of the soles of the
-// feet that touch the ground (`contacts`): their whole outline, not just the points that
-// touch now, so a foot landing on its heel supports the COM over its middle. The outline
-// is each foot geom's horizontal extent: a capsule's axis end points lengthened by its
-// radius, a box's corners, a sphere's centre and radius along x and y. A planar
-// character's support is the outline's x-interval; a free root's its convex hull.
-// -infinity without a foot on the ground.
-double sole_margin(const mjModel* m, const mjData* d, const Character& body, const ContactState& contacts,
-                   const std::array<double, 2>& p);
+// The outline of the soles of the feet that touch the ground (`contacts`): their whole
+// outline, not just the points that touch now, so a foot landing on its heel supports the
+// COM over its middle. It is each foot geom's horizontal extent: a capsule's axis end
+// points lengthened by its radius, a box's corners, a sphere's centre and radius along x
+// and y. A planar character's support is the outline's x-interval; a free root's its
+// convex hull. Built once per state; margin() is the signed distance (m) of a horizontal
+// point from its edge, positive inside, -infinity without a foot on the ground.
+struct SoleOutline {
+  bool planar = false;
+  double lo = 0, hi = -1;   // planar: the x-interval (empty when lo > hi)
+  std::vector<Vec2> hull;   // free root: the convex hull
+  double margin(const Vec2& p) const;
+};
+SoleOutline sole_outline(const mjModel* m, const mjData* d, const Character& body, const ContactState& contacts);
 
 }  // namespace diverse

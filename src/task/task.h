@@ -105,7 +105,7 @@ struct TaskSimulation {
   bool hop_is_fall = false;
   // m; > 0: from topple_after seconds after touch-down, with both feet on the ground,
   // the COM and its capture point (task/support.h) both more than this outside the soles
-  // (sole_margin(), the feet's whole outline) is a fall ("toppled over the edge of the
+  // (sole_outline(), the feet's whole outline) is a fall ("toppled over the edge of the
   // feet"), ranked as a fall a second or more after touch-down: with no foot left to
   // step with, a body seldom brings back a COM that has left its soles that far and is
   // still moving away; without the rule it is simulated until it lies on the ground,

@@ -1,7 +1,7 @@
 // A landing that has toppled over the edge of its feet is a fall from that moment
 // (TaskSimulation::topple_distance, task/task.h): with both feet down and past the
 // landing's first topple_after seconds, the COM and its capture point both more than
-// topple_distance outside the soles' outline (sole_margin(), task/support.h). Most of the
+// topple_distance outside the soles' outline (sole_outline(), task/support.h). Most of the
 // high jump's falls are slow topples over the toes that used to be simulated for a second
 // more, until the COM came down to the feet.
 #include <gtest/gtest.h>
@@ -40,7 +40,7 @@ struct Standing {
   ~Standing() { mj_deleteData(d); }
   Standing(const Standing&) = delete;
   Standing& operator=(const Standing&) = delete;
-  double margin(double x, double y) const { return sole_margin(ev.model().get(), d, ev.body(), contacts, {x, y}); }
+  double margin(double x, double y) const { return sole_outline(ev.model().get(), d, ev.body(), contacts).margin({x, y}); }
   double foot_x(int side) const { return d->xipos[3 * ev.body().feet[static_cast<size_t>(side)]]; }
   TaskEvaluator ev;
   mjData* d;
@@ -58,7 +58,7 @@ TEST(SoleMargin, IsTheDistanceToTheEdgeOfThePlanarSoles) {
   // A foot in the air is no support; neither foot, none at all.
   ContactState one = s.contacts;
   one.foot = {false, false};
-  EXPECT_EQ(sole_margin(s.ev.model().get(), s.d, s.ev.body(), one, {middle, 0}), -INFINITY);
+  EXPECT_EQ(sole_outline(s.ev.model().get(), s.d, s.ev.body(), one).margin({middle, 0}), -INFINITY);
 }
 
 // The 3D human's feet are boxes 27.4 cm long and 10 cm wide: the outline is the hull of
