@@ -40,6 +40,7 @@ struct SeedArgs {
   double sigma = 0;
   int perturbations = 0;
   double perturbation_sigma = 0.02;
+  int selection_samples = 32;
   double min_flight_rotation_deg = 0;
   bool robustness_check = false;
   std::vector<double> check_sigmas{0.02, 0.05};
@@ -64,6 +65,7 @@ std::string searched_options(const SeedArgs& args) {
   if (args.perturbations > 0) {
     options += " --perturbations " + std::to_string(args.perturbations) + " --perturbation-sigma " +
                number(args.perturbation_sigma);
+    if (args.selection_samples != 32) options += " --selection-samples " + std::to_string(args.selection_samples);
   }
   if (args.robust) options += " --robust";
   return options;
@@ -153,6 +155,7 @@ void run(const SeedArgs& args) {
   options.sigma = args.sigma;
   options.perturbations = args.perturbations;
   options.perturbation_sigma = args.perturbation_sigma;
+  options.selection_samples = args.selection_samples;
   options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
   options.first_stage = args.from_stage;
   if (args.robust) {
@@ -213,6 +216,9 @@ void run(const SeedArgs& args) {
     j["constraint"] = constraint;
     j["margin"] = r.margin;
     if (args.perturbations > 0) j["robustness"] = r.robustness;
+    if (!r.selected.empty())
+      j["selection"] = {{"candidates", r.selection_candidates}, {"chosen", r.selected},
+                        {"samples", args.selection_samples}};
     j["found_by"] = command;
     j["parameters"] = p.to_json();
     write_json_atomic(path, j);
@@ -275,6 +281,12 @@ void install(CLI::App& app) {
   cmd->add_option("--perturbation-sigma", args->perturbation_sigma,
                   "Robustness term: their standard deviation, in normalized units")
       ->check(number_in(1e-6, 1.0));
+  cmd->add_option("--selection-samples", args->selection_samples,
+                  "Robustness term: the result is chosen among the last stage's six best "
+                  "candidates, the CMA-ES mean and the start by how many of this many further "
+                  "perturbations meet the task (0 = the best candidate as scored)")
+      ->capture_default_str()
+      ->check(integer_in(0, 1000));
   cmd->add_option("--min-flight-rotation", args->min_flight_rotation_deg,
                   "Require this root rotation (degrees, backwards positive) between take-off and "
                   "touch-down while searching (0 = none)")

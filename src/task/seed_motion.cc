@@ -25,6 +25,9 @@ constexpr int kPatience = 25;       // generations without improvement that end 
 // Stream keys of the perturbation seeds (ASCII "seedrob" and "measrob").
 constexpr std::uint64_t kSeedPerturbations = 0x73656564726f62;
 constexpr std::uint64_t kMeasurePerturbations = 0x6d656173726f62;
+constexpr std::uint64_t kSelectPerturbations = 0x73656c6563726f62;  // "selecrob"
+// Candidates of the last stage that met the task kept for the selection (seed_motion.h).
+constexpr size_t kFinalists = 6;
 
 // Reflection into [0, 1] with period 2, as the bounded CMA-ES maps its genotypes.
 double reflect01(double g) {
@@ -72,6 +75,16 @@ Robustness generation_robustness(const Task& task, int dim, const SeedOptions& o
   return r;
 }
 
+// The selection's perturbation directions (seed_motion.h, "Choosing the result"): fixed
+// for the whole selection, drawn apart from every generation's and from
+// measure_robustness()'s.
+Robustness selection_robustness(const Task& task, int dim, const SeedOptions& options) {
+  Robustness r;
+  r.sigma = options.perturbation_sigma;
+  r.directions = directions(dim, options.selection_samples, derive_seed(task.seed.seed, {kSelectPerturbations}));
+  return r;
+}
+
 // C of one rollout as the search sees it: the task's C plus, when the search asks for a
 // minimum rotation of the root between take-off and touch-down, K_c d^2 for a shortfall
 // of d rad (the task's own weight, as for any other constraint).
@@ -112,6 +125,22 @@ struct Scored {
   long long check_rollouts = 0;
   bool meets() const { return constraint == 0; }
 };
+
+// A candidate for the selection that ends a search with perturbations (seed_motion.h).
+struct Finalist {
+  Eigen::VectorXd x;
+  double f = 0;       // its objective in the generation that scored it
+  std::string label;  // "start", "CMA-ES mean", "generation G"
+};
+
+// Keeps the kFinalists lowest-objective candidates, in order of f (earlier first on ties).
+void keep_finalist(std::vector<Finalist>& finalists, Finalist candidate) {
+  const auto at = std::upper_bound(finalists.begin(), finalists.end(), candidate.f,
+                                   [](double f, const Finalist& c) { return f < c.f; });
+  if (static_cast<size_t>(at - finalists.begin()) >= kFinalists) return;
+  finalists.insert(at, std::move(candidate));
+  if (finalists.size() > kFinalists) finalists.pop_back();
+}
 
 // Scores x on the task at its timestep and again with the timestep halved: a motion
 // counts as meeting the task only if it does so at both timesteps, landing within
@@ -281,6 +310,11 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       result.lowest_mean_f = best.f;
       result.lowest_mean_meets = best.meets();
     }
+    // The selection's candidates (seed_motion.h, "Choosing the result").
+    const bool select = last && stage_options.perturbations > 0 && stage_options.selection_samples > 0;
+    std::vector<Finalist> finalists;
+    const Eigen::VectorXd stage_start = x;
+    const bool stage_start_meets = best.meets();
     auto hand_on = [&](const Eigen::VectorXd& handed, double constraint) {
       if (last || !options.on_stage) return;
       ParameterSet p = start;
@@ -322,6 +356,8 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       bool improved = false;
       for (size_t k = 0; k < xs.size(); ++k) {
         f[k] = scores[k].f;
+        if (select && scores[k].meets())
+          keep_finalist(finalists, {xs[k], scores[k].f, "generation " + std::to_string(es.generation() + 1)});
         if (scores[k].f < best.f) {
           best = scores[k];
           best_x = xs[k];
@@ -362,6 +398,42 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       if (last && best.meets() && since_improvement >= kPatience) break;
     }
     x = have_valid ? best_valid_x : best_x;
+    if (select) {
+      if (stage_start_meets) finalists.insert(finalists.begin(), {stage_start, 0, "start"});
+      finalists.push_back({es.mean(), 0, "CMA-ES mean"});
+      const Robustness selection = selection_robustness(task, dim, stage_options);
+      std::vector<Scored> judged(finalists.size());
+      pool.parallel_for(finalists.size(), [&](std::size_t k, int worker) {
+        const auto w = static_cast<std::size_t>(worker);
+        judged[k] = score(ev, fine, finalists[k].x, *workers[w], *fine_workers[w], selection, stage_options);
+      });
+      int chosen = -1;
+      std::string compared;
+      for (size_t k = 0; k < finalists.size(); ++k) {
+        const Scored& j = judged[k];
+        result.evaluations += static_cast<long long>(2 + selection.directions.size()) + j.check_rollouts;
+        count_check(j);
+        const int held = static_cast<int>(std::lround(j.met * static_cast<double>(selection.directions.size())));
+        compared += (k ? ", " : "") + finalists[k].label + " " +
+                    (j.meets() ? std::to_string(held) : std::string("misses the task"));
+        if (!j.meets()) continue;
+        if (chosen < 0 || j.met > judged[static_cast<size_t>(chosen)].met ||
+            (j.met == judged[static_cast<size_t>(chosen)].met && j.f < judged[static_cast<size_t>(chosen)].f))
+          chosen = static_cast<int>(k);
+      }
+      result.selection_candidates = static_cast<int>(finalists.size());
+      if (chosen >= 0) {
+        const auto c = static_cast<size_t>(chosen);
+        x = finalists[c].x;
+        result.selected = finalists[c].label;
+        result.robustness = judged[c].met;
+      }
+      if (options.log) {
+        options.log("selection on " + std::to_string(selection.directions.size()) +
+                    " perturbations of each (meeting the task): " + compared + "; chosen: " +
+                    (chosen >= 0 ? result.selected : std::string("none meets the task")));
+      }
+    }
     hand_on(x, have_valid ? best_valid.constraint : best.constraint);
     if (last) {
       result.lowest_mean.set_normalized(best_x);
@@ -382,7 +454,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
   result.constraint = final_score.constraint;
   result.requirement_failed = final_score.checked && !final_score.held;
   result.margin = final_score.margin;
-  result.robustness = final_score.met;
+  if (result.selected.empty()) result.robustness = final_score.met;
   result.fell = final_score.fell;
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -395,6 +467,14 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
   for (const Eigen::VectorXd& z : directions(static_cast<int>(x.size()), count, seed)) {
     out.push_back(displaced(x, sigma, z));
   }
+  return out;
+}
+
+std::vector<Eigen::VectorXd> selection_perturbations(const Task& task, const Eigen::VectorXd& x,
+                                                     const SeedOptions& options) {
+  std::vector<Eigen::VectorXd> out;
+  const Robustness r = selection_robustness(task, static_cast<int>(x.size()), options);
+  for (const Eigen::VectorXd& z : r.directions) out.push_back(displaced(x, r.sigma, z));
   return out;
 }
 

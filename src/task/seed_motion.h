@@ -28,8 +28,17 @@
 // directions), and the objective is the mean C over the 2 + P rollouts: the expected
 // penalty under small parameter changes, each perturbation judged as the diversity
 // optimizer will judge it (with the half-timestep check where the task asks for it).
-// The result is the best candidate that meets the task at both timesteps (ranked by that
-// mean), so a neighbourhood that meets the task is preferred to a lucky point.
+// Choosing the result (with perturbations): each generation's mean is over its own few
+// directions, so the candidate with the lowest mean of the whole search is mostly the one
+// whose directions happened to be kind (the winner's curse of noisy optimization), and
+// it holds no more of its neighbourhood than the others. The last stage therefore ends
+// with a selection: the six candidates with the lowest objective that met the task
+// at both timesteps, the CMA-ES mean and the stage's starting point are all simulated at
+// the same SeedOptions::selection_samples perturbations (drawn for the selection alone,
+// not those of measure_robustness(), which stays a measure on directions the search never
+// saw), and the result is the one among them that meets the task and whose perturbations
+// meet it most often (then by the lowest mean C). A search from a motion that meets the
+// task thus never returns one that holds less of the selection's perturbations.
 // Intermediate continuation stages go without: they have to get over the raised object,
 // which a mean over perturbations discourages (a neighbourhood that lands short of a box
 // beats one that partly hits its face).
@@ -88,6 +97,10 @@ struct SeedOptions {
   // standard deviation in normalized units.
   int perturbations = 0;
   double perturbation_sigma = 0.02;
+  // The selection that chooses the result among the last stage's best candidates (see
+  // above): its perturbations at perturbation_sigma (0 = off: the candidate with the
+  // lowest objective is the result). Only with perturbations > 0.
+  int selection_samples = 32;
   // A requirement of the search, not of the task: the root turns at least this much (rad,
   // backwards positive) between take-off and touch-down, else K_c d^2 is added to C for
   // a shortfall of d. 0 = none. Makes a backflip turn in the air rather than on the ground.
@@ -111,7 +124,12 @@ struct SeedResult {
   double constraint = 0;  // C of the result on the full task (sum over both timesteps,
                           // plus the requirement's penalty when it fails it)
   double margin = 0;      // constraint_margin of the result (m)
-  double robustness = 0;  // fraction of the last stage's fixed perturbations met (0 if off)
+  double robustness = 0;  // fraction of the last stage's fixed perturbations met (0 if off);
+                          // with a selection, of the selection's perturbations
+  // The selection (perturbations > 0 and selection_samples > 0): how many candidates it
+  // compared and which it chose ("start", "CMA-ES mean", "generation G"); empty if none ran.
+  int selection_candidates = 0;
+  std::string selected;
   bool fell = true;
   // With a requirement: the result meets the task at both timesteps but fails the
   // requirement (its C is then the requirement's penalty); and, over the last stage's
@@ -159,6 +177,12 @@ struct RobustnessReport {
 };
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
                                     const std::vector<double>& sigmas, int samples, int threads);
+
+// The perturbations of the normalized x on which the selection that ends a search with
+// perturbations compares its candidates (options.selection_samples of them at
+// options.perturbation_sigma; the same directions for every candidate and every x).
+std::vector<Eigen::VectorXd> selection_perturbations(const Task& task, const Eigen::VectorXd& x,
+                                                     const SeedOptions& options);
 
 // The seed of measure_robustness()'s perturbations at `sigma`: from the task's seed.seed
 // and the value of sigma alone, so a sigma gets the same perturbations whatever other

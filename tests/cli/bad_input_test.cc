@@ -135,6 +135,7 @@ TEST(BadInput, OptionsOfEverySubcommand) {
       // --robust is a flag, and goes with the other options in their ranges only.
       {"seed-motion jump_high --robust=maybe", "--robust = maybe"},
       {"seed-motion jump_high --robust --perturbations -1", "--perturbations: expected an integer in [0, 1000], got '-1'"},
+      {"seed-motion jump_high --perturbations 4 --selection-samples -1", "--selection-samples: expected an integer in [0, 1000], got '-1'"},
       {"seed-motion jump_high --robust --generations 0", "--generations: expected an integer in [1, 100000], got '0'"},
       {"seed-motion jump_high --robust --robustness-check --check-samples 0",
        "--check-samples: expected an integer in [1, 100000], got '0'"},

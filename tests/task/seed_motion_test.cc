@@ -138,6 +138,7 @@ TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
   options.generations = 1;
   options.perturbations = 2;
   options.perturbation_sigma = 0.02;
+  options.selection_samples = 8;
   options.threads = 1;
   const SeedResult one = seed_motion(task, m0, options);
   options.threads = 2;
@@ -145,7 +146,66 @@ TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(one.parameters.values(), two.parameters.values());
   EXPECT_EQ(one.robustness, two.robustness);
   EXPECT_EQ(one.lowest_mean.values(), two.lowest_mean.values());
-  EXPECT_EQ(one.evaluations, 4 * (1 + task.seed.popsize));
+  EXPECT_EQ(one.selected, two.selected);
+  // The generation's rollouts, then the selection's: each candidate at both timesteps and
+  // at its 8 perturbations.
+  EXPECT_EQ(one.evaluations, 4 * (1 + task.seed.popsize) + one.selection_candidates * (2 + 8));
+  EXPECT_EQ(two.evaluations, one.evaluations);
+}
+
+// The selection that ends a search with perturbations: every candidate is judged on the same
+// fixed perturbations, and the result is the one that meets the task whose perturbations
+// meet it most often, so a search from a motion that meets the task never returns one that
+// holds fewer of them. Counted here from outside, with the half-timestep check as the
+// diversity optimizer judges a sample.
+TEST(SeedMotion, TheSelectionNeverReturnsAMotionHoldingLessOfItsPerturbationsThanTheStart) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 2;
+  options.sigma = 0.02;
+  options.perturbations = 2;
+  options.perturbation_sigma = 0.03;
+  options.selection_samples = 12;
+  std::vector<std::string> lines;
+  options.log = [&](const std::string& line) { lines.push_back(line); };
+  const SeedResult r = seed_motion(task, m0, options);
+  ASSERT_EQ(r.constraint, 0.0);
+  ASSERT_FALSE(r.selected.empty());
+  // The start and the CMA-ES mean are always among the candidates, and so is every
+  // generation's candidate that met the task, up to six.
+  EXPECT_GE(r.selection_candidates, 2);
+  EXPECT_LE(r.selection_candidates, 8);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back().rfind("selection on 12 perturbations of each", 0), 0u) << lines.back();
+  EXPECT_NE(lines.back().find("chosen: " + r.selected), std::string::npos) << lines.back();
+
+  EvaluationOptions judged;
+  judged.samples_per_phase = 0;
+  judged.half_timestep_check = true;
+  auto worker = ev.make_worker();
+  auto held = [&](const ParameterSet& p) {
+    int met = 0;
+    for (const Eigen::VectorXd& y : selection_perturbations(task, p.normalized(), options))
+      met += ev.evaluate_normalized(y, *worker, judged).constraint == 0 ? 1 : 0;
+    return met;
+  };
+  const int start_held = held(m0);
+  const int result_held = held(r.parameters);
+  EXPECT_GE(result_held, start_held);
+  EXPECT_DOUBLE_EQ(r.robustness, result_held / 12.0);
+  // The perturbations are the selection's own, not the robustness check's.
+  EXPECT_NE(selection_perturbations(task, m0.normalized(), options)[0],
+            perturb(m0.normalized(), 0.03, 1, robustness_seed(task, 0.03))[0]);
+
+  // Without the selection, the result is the candidate with the lowest objective.
+  options.selection_samples = 0;
+  const SeedResult plain = seed_motion(task, m0, options);
+  EXPECT_TRUE(plain.selected.empty());
+  EXPECT_EQ(plain.selection_candidates, 0);
+  EXPECT_EQ(plain.evaluations, 4 * (1 + 2 * task.seed.popsize));
 }
 
 // The landing spot is where the feet touch down and where they rest, whichever moved more.
