@@ -446,6 +446,15 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
     // so that sum alpha_s cop_s = held; and each leg pushes alpha_s F from there. The legs'
     // forces add up to F, their moment about the COM is (held - c) x F = 0, and they do not
     // squeeze the feet apart.
+    // A push is shared otherwise: its F_z is held at a tenth of the weight while the COM
+    // rises (F_z = M (g - height_kd v_z)), so the centre of pressure it implies lies
+    // h F_xy / F_z from the COM, ten times further than in balance, and the load split by
+    // it turned a lateral COM speed of 1 cm/s into 60 % of the push on one leg (left and
+    // right then parted threefold per step), while each foot's point moved sideways by it
+    // rolled the bird's feet on their front edges (its two sides parted twofold every
+    // 14 ms). Two stance legs push half each, from their own soles' centres moved only
+    // along the heading.
+    const bool push = com_force_ == ComForce::kPush;
     std::array<double, 2> load{stance_[0] ? 1.0 : 0.0, stance_[1] ? 1.0 : 0.0};
     const int first = stance_[0] ? 0 : 1;
     Vec2 residual{held[0] - foot_centre[static_cast<size_t>(first)][0],
@@ -455,17 +464,17 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       const Vec2& r = foot_centre[1];
       const double dx = l[0] - r[0], dy = l[1] - r[1];
       const double len2 = dx * dx + dy * dy;
-      // A push shares its force equally: its F_z is held at a tenth of the weight while the
-      // COM rises (F_z = M (g - height_kd v_z)), so the centre of pressure it implies lies
-      // h F_xy / F_z from the COM, ten times further than in balance, and splitting the
-      // load by it turned a lateral COM speed of 1 cm/s into 60 % of the push on one leg:
-      // left and right then parted threefold every step of the push-off.
       double alpha = len2 > 1e-8 ? ((held[0] - r[0]) * dx + (held[1] - r[1]) * dy) / len2 : 0.5;
-      if (com_force_ == ComForce::kPush) alpha = 0.5;
+      if (push) alpha = 0.5;
       alpha = std::clamp(alpha, 0.0, 1.0);
       load = {alpha, 1 - alpha};
       residual = {held[0] - (alpha * l[0] + (1 - alpha) * r[0]),
                   held[1] - (alpha * l[1] + (1 - alpha) * r[1])};
+    }
+    if (push && legs == 2) {
+      const double c = std::cos(heading_), sn = std::sin(heading_);
+      const double along = residual[0] * c + residual[1] * sn;
+      residual = {along * c, along * sn};
     }
     for (int s = 0; s < 2; ++s) {
       const Vec2& f = foot_centre[static_cast<size_t>(s)];

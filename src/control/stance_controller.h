@@ -28,11 +28,12 @@
 //   is its sole's centre moved by what lies off that line (so sum alpha_s cop_s = p), and
 //   each leg pushes alpha_s F from cop_s. The legs' forces add up to F, their moment about
 //   the COM is (p - c) x F = 0, and they do not squeeze the feet apart (the feet would
-//   creep on MuJoCo's soft friction). A push (ComForce::kPush) shares F equally between
-//   two stance legs: with its F_z held at a tenth of the weight while the COM rises, p
-//   lies ten times further from the COM than in balance, and a load split by it made a
-//   push-off chaotic (a 1e-6 change of a jump's parameters parted left and right threefold
-//   per step at take-off).
+//   creep on MuJoCo's soft friction). A push (ComForce::kPush) with two stance legs
+//   shares F equally, each leg pushing from its sole's centre moved only along the
+//   heading: with its F_z held at a tenth of the weight while the COM rises, p lies ten
+//   times further from the COM than in balance, and a load split by it, or feet pushing
+//   from points moved sideways by it, made a push-off chaotic (a 1e-6 change of a jump's
+//   parameters parted its left and right threefold per step at the human's take-off).
 // - Root (pelvis) and torso. The root tracks an upright orientation with the heading it had
 //   at reset(): a world torque T = root_kp e_root - root_kd w_root (e the rotation vector to
 //   the target, w the angular velocity). The root is unactuated, so the stance legs supply
