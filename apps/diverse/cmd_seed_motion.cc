@@ -41,6 +41,7 @@ struct SeedArgs {
   int perturbations = 0;
   double perturbation_sigma = 0.02;
   int selection_samples = 32;
+  std::string objective = "mean";
   double min_flight_rotation_deg = 0;
   bool robustness_check = false;
   std::vector<double> check_sigmas{0.02, 0.05};
@@ -66,6 +67,7 @@ std::string searched_options(const SeedArgs& args) {
     options += " --perturbations " + std::to_string(args.perturbations) + " --perturbation-sigma " +
                number(args.perturbation_sigma);
     if (args.selection_samples != 32) options += " --selection-samples " + std::to_string(args.selection_samples);
+    if (args.objective != "mean") options += " --objective " + args.objective;
   }
   if (args.robust) options += " --robust";
   return options;
@@ -141,6 +143,8 @@ void check(const SeedArgs& args) {
 }
 
 void run(const SeedArgs& args) {
+  if (args.objective != "mean" && args.objective != "share")
+    throw UserError("--objective: expected mean or share, got '" + args.objective + "'");
   if (args.robustness_check) return check(args);
   const Task task = task_at_strength(args);
   const TaskEvaluator ev(task);
@@ -156,6 +160,7 @@ void run(const SeedArgs& args) {
   options.perturbations = args.perturbations;
   options.perturbation_sigma = args.perturbation_sigma;
   options.selection_samples = args.selection_samples;
+  options.objective = args.objective == "share" ? SeedObjective::kShare : SeedObjective::kMeanC;
   options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
   options.first_stage = args.from_stage;
   if (args.robust) {
@@ -287,6 +292,10 @@ void install(CLI::App& app) {
                   "perturbations meet the task (0 = the best candidate as scored)")
       ->capture_default_str()
       ->check(integer_in(0, 1000));
+  cmd->add_option("--objective", args->objective,
+                  "Robustness term: a candidate's objective over its rollouts, \"mean\" (the mean C) "
+                  "or \"share\" (the share that misses the task, misses ranked by log(1 + C) / 100)")
+      ->capture_default_str();
   cmd->add_option("--min-flight-rotation", args->min_flight_rotation_deg,
                   "Require this root rotation (degrees, backwards positive) between take-off and "
                   "touch-down while searching (0 = none)")

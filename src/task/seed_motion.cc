@@ -182,7 +182,10 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
     s.check_rollouts = verdict.rollouts;
     if (!verdict.holds) s.constraint += seed.requirement.penalty;
   }
-  double sum = s.constraint;
+  // What a rollout adds to the objective: its C, or with the share objective 1 when it
+  // misses the task plus log(1 + C) / 100 to rank the misses (seed_motion.h).
+  auto term = [&seed](double c) { return objective_term(seed.objective, c); };
+  double sum = seed.objective == SeedObjective::kShare ? 2 * term(s.constraint) : s.constraint;
   int met = 0;
   // Perturbations meet the task as the diversity optimizer will judge them: with the
   // half-timestep check where the task asks for it.
@@ -191,7 +194,7 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
   for (const Eigen::VectorXd& z : robust.directions) {
     const double c = seed_constraint(
         ev.evaluate_normalized(displaced(x, robust.sigma, z), worker, perturbed), ev.task(), seed);
-    sum += c;
+    sum += term(c);
     if (c == 0) ++met;
   }
   const auto n = static_cast<double>(robust.directions.size());
@@ -468,6 +471,11 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
     out.push_back(displaced(x, sigma, z));
   }
   return out;
+}
+
+double objective_term(SeedObjective objective, double c) {
+  if (objective == SeedObjective::kMeanC) return c;
+  return c > 0 ? 1.0 + std::log1p(c) / 100 : 0.0;
 }
 
 std::vector<Eigen::VectorXd> selection_perturbations(const Task& task, const Eigen::VectorXd& x,

@@ -45,6 +45,13 @@
 // measure_robustness() reports the fraction of another set of perturbations that meet
 // the task.
 //
+// The share objective (SeedOptions::objective = kShare, `--objective share`): the mean C
+// ranks a region whose perturbations all land a few centimetres outside the box (C of
+// tens) above one where half meet the task and half fall (C of 1e5), so a search for a
+// robust jump drifts to near misses. With kShare each rollout adds 1 if it misses the task
+// plus log(1 + C) / 100 (at most about 0.12), 0 if it meets it: f is the share of the
+// rollouts that miss, the misses ranked among themselves by how far they miss.
+//
 // A requirement beyond the task (SeedOptions::requirement; `diverse seed-motion --robust`
 // sets it to the robustness suite's small part, robust/robustness.h robust_sample_suite()):
 // a candidate of the last stage that meets the task at both timesteps (C = 0) meets it
@@ -89,6 +96,8 @@ struct SeedRequirement {
   explicit operator bool() const { return static_cast<bool>(check); }
 };
 
+enum class SeedObjective { kMeanC, kShare };
+
 struct SeedOptions {
   int threads = 1;
   int generations = 0;  // per stage; 0 = the task's seed.generations
@@ -101,6 +110,8 @@ struct SeedOptions {
   // above): its perturbations at perturbation_sigma (0 = off: the candidate with the
   // lowest objective is the result). Only with perturbations > 0.
   int selection_samples = 32;
+  // How the rollouts of a candidate make its objective (see above).
+  SeedObjective objective = SeedObjective::kMeanC;
   // A requirement of the search, not of the task: the root turns at least this much (rad,
   // backwards positive) between take-off and touch-down, else K_c d^2 is added to C for
   // a shortfall of d. 0 = none. Makes a backflip turn in the air rather than on the ground.
@@ -177,6 +188,12 @@ struct RobustnessReport {
 };
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
                                     const std::vector<double>& sigmas, int samples, int threads);
+
+// What one rollout with constraint penalty c adds to a candidate's objective (see above):
+// c itself (kMeanC), or 0 when it meets the task and 1 + log(1 + c) / 100 when it misses
+// (kShare). For x itself, counted at both timesteps, the mean objective adds its summed C
+// once and the share objective its term twice.
+double objective_term(SeedObjective objective, double c);
 
 // The perturbations of the normalized x on which the selection that ends a search with
 // perturbations compares its candidates (options.selection_samples of them at

@@ -136,6 +136,7 @@ TEST(BadInput, OptionsOfEverySubcommand) {
       {"seed-motion jump_high --robust=maybe", "--robust = maybe"},
       {"seed-motion jump_high --robust --perturbations -1", "--perturbations: expected an integer in [0, 1000], got '-1'"},
       {"seed-motion jump_high --perturbations 4 --selection-samples -1", "--selection-samples: expected an integer in [0, 1000], got '-1'"},
+      {"seed-motion jump_high --perturbations 4 --objective median", "--objective: expected mean or share, got 'median'"},
       {"seed-motion jump_high --robust --generations 0", "--generations: expected an integer in [1, 100000], got '0'"},
       {"seed-motion jump_high --robust --robustness-check --check-samples 0",
        "--check-samples: expected an integer in [1, 100000], got '0'"},

@@ -153,6 +153,49 @@ TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(two.evaluations, one.evaluations);
 }
 
+// The share objective counts the rollouts that miss the task, and ranks the misses among
+// themselves: a near miss (C = 25, a landing 7 cm out) costs about as much as a fall, and
+// a candidate with half its rollouts meeting ranks above one whose rollouts all miss
+// narrowly, which the mean C ranks the other way round.
+TEST(SeedMotion, TheShareObjectiveRanksMeetingAboveNearMisses) {
+  using enum SeedObjective;
+  EXPECT_EQ(objective_term(kShare, 0.0), 0.0);
+  EXPECT_GT(objective_term(kShare, 1e-9), 1.0);
+  EXPECT_LT(objective_term(kShare, 25.0), objective_term(kShare, 1e5));
+  EXPECT_LT(objective_term(kShare, 3e5), 1.13);
+  EXPECT_EQ(objective_term(kMeanC, 25.0), 25.0);
+  auto mean = [](SeedObjective o, const std::vector<double>& c) {
+    double sum = 0;
+    for (double v : c) sum += objective_term(o, v);
+    return sum / static_cast<double>(c.size());
+  };
+  const std::vector<double> half_met{0, 0, 0, 0, 1e5, 1e5, 1e5, 1e5};
+  const std::vector<double> all_near{25, 25, 25, 25, 25, 25, 25, 25};
+  EXPECT_LT(mean(kShare, half_met), mean(kShare, all_near));
+  EXPECT_GT(mean(kMeanC, half_met), mean(kMeanC, all_near));
+
+  // A search with it reports objectives on its scale: at most 1.13 for any candidate.
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.perturbations = 2;
+  options.perturbation_sigma = 0.03;
+  options.selection_samples = 0;
+  options.objective = kShare;
+  std::vector<double> lowest;
+  options.log = [&](const std::string& line) {
+    const auto at = line.find("lowest f=");
+    if (at != std::string::npos) lowest.push_back(std::stod(line.substr(at + 9)));
+  };
+  const SeedResult r = seed_motion(task, ev.load_parameters(task.m0), options);
+  ASSERT_EQ(lowest.size(), 1u);
+  EXPECT_LE(lowest[0], 1.13);
+  EXPECT_GE(lowest[0], -task.seed.robustness * 0.1);
+  EXPECT_NEAR(r.lowest_mean_f, lowest[0], 1e-5);  // printed to 6 digits
+}
+
 // The selection that ends a search with perturbations: every candidate is judged on the same
 // fixed perturbations, and the result is the one that meets the task whose perturbations
 // meet it most often, so a search from a motion that meets the task never returns one that
