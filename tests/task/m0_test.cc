@@ -75,7 +75,7 @@ struct Neighbourhood {
 const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"backflip", {0.0005, 32, 3}},
     {"jump_forward", {0.02, 32, 14}},
-    {"jump_onto", {0.01, 32, 5}},
+    {"jump_onto", {0.01, 32, 16}},
     {"jump_over", {0.003, 32, 5}},
     {"jump_high", {0.02, 32, 20}},
     // The 3D jumps: perturbed on both sides apart (their tasks' `asymmetric = true`) and

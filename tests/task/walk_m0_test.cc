@@ -54,14 +54,17 @@ TEST(WalkM0, HumanMeetsItsTaskAtHalfTheTimestep) { expect_walk_meets("silly_walk
 TEST(WalkM0, RobotMeetsItsTask) { expect_walk_meets("robot_silly_walk", 0); }
 TEST(WalkM0, RobotMeetsItsTaskAtHalfTheTimestep) { expect_walk_meets("robot_silly_walk", 0.001); }
 
-TEST(WalkM0, PartOfTheNeighbourhoodMeetsTheTask) {
+// Half or more of the input walks' perturbations at a normalized step of 0.02 meet the task,
+// at both timesteps (the committed walks: 28 and 18 of 32; `diverse seed-motion TASK
+// --robustness-check`).
+TEST(WalkM0, HalfOfTheNeighbourhoodMeetsTheTask) {
   for (const char* name : {"silly_walk", "robot_silly_walk"}) {
     const Task task = load_task(kTasks + name + std::string(".toml"));
     const TaskEvaluator ev(task);
-    const RobustnessReport r = measure_robustness(task, ev.load_parameters(task.m0), {0.01}, 8, 1);
+    const RobustnessReport r = measure_robustness(task, ev.load_parameters(task.m0), {0.02}, 32, 2);
     EXPECT_EQ(r.constraint, 0) << name;
     EXPECT_EQ(r.constraint_fine, 0) << name;
-    EXPECT_GE(r.levels[0].met, 1) << name << ": of 8 perturbations at 0.01";
+    EXPECT_GE(r.levels[0].met, 16) << name << ": of 32 perturbations at 0.02";
   }
 }
 
