@@ -464,17 +464,16 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       const Vec2& r = foot_centre[1];
       const double dx = l[0] - r[0], dy = l[1] - r[1];
       const double len2 = dx * dx + dy * dy;
-      double alpha = len2 > 1e-8 ? ((held[0] - r[0]) * dx + (held[1] - r[1]) * dy) / len2 : 0.5;
-      if (push) alpha = 0.5;
+      double alpha = push || len2 <= 1e-8 ? 0.5 : ((held[0] - r[0]) * dx + (held[1] - r[1]) * dy) / len2;
       alpha = std::clamp(alpha, 0.0, 1.0);
       load = {alpha, 1 - alpha};
       residual = {held[0] - (alpha * l[0] + (1 - alpha) * r[0]),
                   held[1] - (alpha * l[1] + (1 - alpha) * r[1])};
-    }
-    if (push && legs == 2) {
-      const double c = std::cos(heading_), sn = std::sin(heading_);
-      const double along = residual[0] * c + residual[1] * sn;
-      residual = {along * c, along * sn};
+      if (push) {  // only the part along the heading
+        const double c = std::cos(heading_), sn = std::sin(heading_);
+        const double along = residual[0] * c + residual[1] * sn;
+        residual = {along * c, along * sn};
+      }
     }
     for (int s = 0; s < 2; ++s) {
       const Vec2& f = foot_centre[static_cast<size_t>(s)];

@@ -78,10 +78,12 @@ Robustness generation_robustness(const Task& task, int dim, const SeedOptions& o
 // The selection's perturbation directions (seed_motion.h, "Choosing the result"): fixed
 // for the whole selection, drawn apart from every generation's and from
 // measure_robustness()'s.
+std::uint64_t selection_seed(const Task& task) { return derive_seed(task.seed.seed, {kSelectPerturbations}); }
+
 Robustness selection_robustness(const Task& task, int dim, const SeedOptions& options) {
   Robustness r;
   r.sigma = options.perturbation_sigma;
-  r.directions = directions(dim, options.selection_samples, derive_seed(task.seed.seed, {kSelectPerturbations}));
+  r.directions = directions(dim, options.selection_samples, selection_seed(task));
   return r;
 }
 
@@ -480,10 +482,7 @@ double objective_term(SeedObjective objective, double c) {
 
 std::vector<Eigen::VectorXd> selection_perturbations(const Task& task, const Eigen::VectorXd& x,
                                                      const SeedOptions& options) {
-  std::vector<Eigen::VectorXd> out;
-  const Robustness r = selection_robustness(task, static_cast<int>(x.size()), options);
-  for (const Eigen::VectorXd& z : r.directions) out.push_back(displaced(x, r.sigma, z));
-  return out;
+  return perturb(x, options.perturbation_sigma, options.selection_samples, selection_seed(task));
 }
 
 std::uint64_t robustness_seed(const Task& task, double sigma) {
