@@ -33,8 +33,9 @@ std::vector<DrivenJoint> driven_joints(const mjModel* m) {
   return joints;
 }
 
-JointDrive::JointDrive(std::vector<DrivenJoint> joints)
+JointDrive::JointDrive(std::vector<DrivenJoint> joints, SaturatedDrive saturated)
     : joints_(std::move(joints)),
+      saturated_(saturated),
       u_(joints_.size(), 0.0),
       kd_(joints_.size(), 0.0),
       qdot_(joints_.size(), 0.0),
@@ -56,7 +57,7 @@ bool JointDrive::apply(mjModel* m, mjData* d) {
     // on top of a clamped motor is what broke the limit before.
     const bool implicit = std::fabs(u) <= j.limit && std::fabs(request) <= j.limit;
     explicit_[k] = implicit ? 0 : 1;
-    d->ctrl[j.actuator] = implicit ? u : std::clamp(request, -j.limit, j.limit);
+    d->ctrl[j.actuator] = implicit ? u : explicit_torque(m, d, k, qdot);
     const double damping = implicit ? kd : 0.0;
     if (m->dof_damping[j.dof] != damping) {
       m->dof_damping[j.dof] = damping;
@@ -66,10 +67,30 @@ bool JointDrive::apply(mjModel* m, mjData* d) {
   return damping_changed;
 }
 
+double JointDrive::explicit_torque(const mjModel* m, mjData* d, size_t k, double qdot) {
+  const DrivenJoint& j = joints_[k];
+  double request = u_[k] - kd_[k] * qdot;
+  if (saturated_ == SaturatedDrive::kStablePd && kd_[k] > 0) {
+    // (M^-1)_kk from the factorization mj_step1 left in d->qLD (header).
+    const auto nv = static_cast<size_t>(m->nv);
+    if (unit_.size() != nv) {
+      unit_.assign(nv, 0);
+      response_.assign(nv, 0);
+    }
+    unit_[static_cast<size_t>(j.dof)] = 1;
+    mj_solveM(m, d, response_.data(), unit_.data(), 1);
+    unit_[static_cast<size_t>(j.dof)] = 0;
+    const double inverse_inertia = response_[static_cast<size_t>(j.dof)];
+    if (inverse_inertia > 0 && std::isfinite(inverse_inertia))
+      request /= 1 + m->opt.timestep * kd_[k] * inverse_inertia;
+  }
+  return std::clamp(request, -j.limit, j.limit);
+}
+
 void JointDrive::make_explicit(mjModel* m, mjData* d, size_t k) {
   const DrivenJoint& j = joints_[k];
   explicit_[k] = 1;
-  d->ctrl[j.actuator] = std::clamp(u_[k] - kd_[k] * qdot_[k], -j.limit, j.limit);
+  d->ctrl[j.actuator] = explicit_torque(m, d, k, qdot_[k]);
   m->dof_damping[j.dof] = 0;
 }
 

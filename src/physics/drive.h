@@ -22,6 +22,22 @@
 //  - explicit: dof_damping = 0, ctrl = clamp(u - kd qdot_t). The net torque is ctrl, within
 //    the limit by construction (the motor's forcerange is the limit).
 //
+// Explicit damping is unstable once kd h / I > 2 (h the step, I the joint's effective
+// inertia): at a jump's flight gains a joint swinging hard towards its target, its request
+// at the limit or its spring part beyond it, overshoots, its next request is at the limit
+// the other way, and the net torque alternates step by step between +limit and -limit (the
+// backflip's hips in the air at 2 ms; two motions 1e-6 apart part by 1e-2 within 0.1 s).
+// SaturatedDrive::kStablePd applies such a joint's request with its damper on the
+// predicted end-of-step velocity, as stable PD control does (Tan, Liu and Turk 2011):
+//
+//     ctrl = clamp((u - kd qdot_t) / (1 + h kd / I)),    I = 1 / (M^-1)_kk
+//
+// (I from the factorized mass matrix: the joint's inertia with every other joint and the
+// root free; contacts only make it larger). For a joint alone this is the implicit
+// solution u - kd qdot_{t+1}; its damping gain kd / (1 + h kd / I) is stable for any kd.
+// The net torque is still ctrl, within the limit. SaturatedDrive::kExplicit (the default)
+// is the plain clamp above, with which every input motion of the first release was found.
+//
 // An implicit joint can still exceed its limit if qdot_{t+1} jumps (an impact within the
 // step). run_rollout() (physics/rollout.h) therefore integrates, checks every implicit
 // joint's net torque on qdot_{t+1}, and if one exceeds its limit restores the state from
@@ -50,10 +66,15 @@ struct DrivenJoint {
 // forcerange [-L, L], L > 0, on a joint no other actuator acts on. In actuator order.
 std::vector<DrivenJoint> driven_joints(const mjModel* m);
 
+// How an explicit joint's damping is applied (above): on qdot_t, or on the predicted
+// end-of-step velocity (a task's `[simulation] saturated_drive`, "explicit" or "stable_pd").
+enum class SaturatedDrive { kExplicit, kStablePd };
+
 class JointDrive {
  public:
   JointDrive() = default;
-  explicit JointDrive(std::vector<DrivenJoint> joints);
+  explicit JointDrive(std::vector<DrivenJoint> joints,
+                      SaturatedDrive saturated = SaturatedDrive::kExplicit);
 
   int size() const { return static_cast<int>(joints_.size()); }
   const std::vector<DrivenJoint>& joints() const { return joints_; }
@@ -98,8 +119,13 @@ class JointDrive {
  private:
   void make_explicit(mjModel* m, mjData* d, size_t k);
 
+  // The explicit torque of joint k from its request, qdot and (for kStablePd) the state.
+  double explicit_torque(const mjModel* m, mjData* d, size_t k, double qdot);
+
   std::vector<DrivenJoint> joints_;
+  SaturatedDrive saturated_ = SaturatedDrive::kExplicit;
   std::vector<int> dofs_;
+  std::vector<mjtNum> unit_, response_;  // kStablePd scratch: e_k and M^-1 e_k
   std::vector<double> u_, kd_;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
   std::vector<char> explicit_;  // per joint: damping applied explicitly in the motor

@@ -162,7 +162,7 @@ void read_simulation(const TomlReader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
           "fall_tilt", "clearance_range", "timestep", "balanced_rest",
           "rest_hold", "hop_is_fall", "topple_distance",
-          "topple_after"});
+          "topple_after", "saturated_drive"});
   TaskSimulation& s = task.simulation;
   s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
   s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
@@ -172,6 +172,16 @@ void read_simulation(const TomlReader& r, Task& task) {
   s.hop_is_fall = r.boolean("hop_is_fall", s.hop_is_fall);
   s.topple_distance = r.number("topple_distance", 0, 1, s.topple_distance);
   s.topple_after = r.number("topple_after", 0, 5, s.topple_after);
+  if (r.has("saturated_drive")) {
+    const std::string way = r.string("saturated_drive");
+    if (way == "explicit") {
+      s.saturated_drive = SaturatedDrive::kExplicit;
+    } else if (way == "stable_pd") {
+      s.saturated_drive = SaturatedDrive::kStablePd;
+    } else {
+      r.fail("saturated_drive", "expected \"explicit\" or \"stable_pd\", got \"" + way + "\"");
+    }
+  }
   s.max_time = r.number("max_time", 0.5, 60, s.max_time);
   s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
   s.fall_tilt = r.number("fall_tilt", 0, 3.14, s.fall_tilt);

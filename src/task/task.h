@@ -116,6 +116,11 @@ struct TaskSimulation {
   // task; docs/results.md, "Ending topples").
   double topple_distance = 0;
   double topple_after = 0.2;  // s
+  // How the joint drive applies a request at the torque limit or with its spring part
+  // beyond it (physics/drive.h): `saturated_drive = "explicit"` (the default; the damper
+  // on the step's start velocity, which chatters at a jump's flight gains) or "stable_pd"
+  // (the damper on the predicted end-of-step velocity).
+  SaturatedDrive saturated_drive = SaturatedDrive::kExplicit;
 };
 
 struct TaskSeed {

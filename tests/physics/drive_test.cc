@@ -159,10 +159,10 @@ void replay_checks(const Scene& s, Outcome* o) {
   mj_deleteModel(m);
 }
 
-Outcome run_driven(const Scene& s, int steps) {
+Outcome run_driven(const Scene& s, int steps, SaturatedDrive saturated = SaturatedDrive::kExplicit) {
   SimWorker worker(s.model);
   set_initial_state(s, worker);
-  JointDrive drive(driven_joints(s.model->get()));
+  JointDrive drive(driven_joints(s.model->get()), saturated);
   DrivenPd hooks(worker.model(), &drive, s.pd);
   Outcome o;
   o.stats = run_rollout(worker, hooks, steps, drive, &o.record);
@@ -281,7 +281,62 @@ TEST(JointDrive, FarFromTheLimitsItIsPlainImplicitPd) {
   EXPECT_EQ(driven.record.ctrl, plain.record.ctrl);
 }
 
-// (d) A 1 kg block on a slide joint, no gravity: the Euler step solves
+// (d) A saturated swing at flight gains: an arm in zero gravity driven towards a target a
+// radian away with kd h / I = 4.8 (beyond explicit damping's stability bound of 2). The
+// spring part stays beyond the 20 Nm limit all the way, so every step is applied
+// explicitly: with the damper on qdot_t the net torque flips between the limit and the
+// other way step after step (it still closes on the target on average); with the damper on the predicted
+// end-of-step velocity (SaturatedDrive::kStablePd) it swings over and settles at the
+// target, within the limit and replaying exactly.
+TEST(JointDrive, StablePdKeepsASaturatedSwingFromChattering) {
+  constexpr const char* kFreeArm = R"(
+<mujoco>
+  <option timestep="0.002" integrator="Euler" gravity="0 0 0"/>
+  <worldbody>
+    <body pos="0 0 1">
+      <joint name="shoulder" type="hinge" axis="0 -1 0"/>
+      <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="shoulder" forcelimited="true" forcerange="-20 20"/>
+  </actuator>
+</mujoco>)";
+  const Scene s{SharedModel::from_xml(kFreeArm, "free_arm"), {{1.0}, {400}, {200}}, {}, {}};
+  // The arm's inertia about the shoulder: kd h / I must be beyond 2 for the test to mean it.
+  {
+    SimWorker w(s.model);
+    mj_forward(w.model(), w.data());
+    ASSERT_GT(200 * 0.002 / w.data()->qM[0], 2.0);
+  }
+  const int qadr = s.model->get()->jnt_qposadr[0];
+  auto sign_flips = [](const Outcome& o) {
+    int flips = 0;
+    for (int step = 1; step < o.record.steps(); ++step) {
+      const double a = o.record.actuator_force[static_cast<size_t>(step - 1)];
+      const double b = o.record.actuator_force[static_cast<size_t>(step)];
+      if (a * b < 0 && std::fabs(a - b) > 20) ++flips;  // a jump across more than the limit
+    }
+    return flips;
+  };
+  // 4 s: overdamped (kp / kd = 2 / s), the arm closes on the target as 1 - e^{-2 t}.
+  const Outcome plain = run_driven(s, 2000, SaturatedDrive::kExplicit);
+  const Outcome stable = run_driven(s, 2000, SaturatedDrive::kStablePd);
+  print("free arm, explicit", plain);
+  print("free arm, stable PD", stable);
+  const double q_plain = plain.record.qpos[static_cast<size_t>((plain.record.steps() - 1) * plain.record.nq + qadr)];
+  const double q_stable = stable.record.qpos[static_cast<size_t>((stable.record.steps() - 1) * stable.record.nq + qadr)];
+  std::printf("sign flips across the limit: explicit %d, stable PD %d; final q %.4f / %.4f\n",
+              sign_flips(plain), sign_flips(stable), q_plain, q_stable);
+  EXPECT_GT(sign_flips(plain), 100);
+  EXPECT_EQ(sign_flips(stable), 0);
+  EXPECT_NEAR(q_stable, 1.0, 0.01);
+  EXPECT_EQ(stable.check.steps, 2000);
+  EXPECT_LE(stable.check.worst_excess, 0.0);
+  EXPECT_EQ(stable.replay_diff, 0.0);
+}
+
+// (e) A 1 kg block on a slide joint, no gravity: the Euler step solves
 // (m + h kd) a = ctrl - kd v0, and the net force motor + damper is m a.
 TEST(CheckNetTorque, SlidingBlockHasTheClosedFormNetForce) {
   constexpr const char* kBlock = R"(

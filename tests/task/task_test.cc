@@ -195,6 +195,17 @@ TEST_F(TaskFileTest, OutOfRange) {
   EXPECT_EQ(unknown.rfind(": diversity.lambda: expected no such key", 0), 0u) << unknown;
 }
 
+TEST_F(TaskFileTest, SaturatedDrive) {
+  EXPECT_EQ(load_task(write(valid_text())).simulation.saturated_drive, SaturatedDrive::kExplicit);
+  EXPECT_EQ(load_task(write(valid_text() + "[simulation]\nsaturated_drive = \"stable_pd\"\n"))
+                .simulation.saturated_drive,
+            SaturatedDrive::kStablePd);
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\nsaturated_drive = \"implicit\"\n"),
+            ": simulation.saturated_drive: expected \"explicit\" or \"stable_pd\", got \"implicit\"");
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\nsaturated_drive = 1\n"),
+            ": simulation.saturated_drive: expected a string");
+}
+
 TEST_F(TaskFileTest, ModelPathMissing) {
   const std::string e = error_of(replace(valid_text(), "human2d.xml", "nobody.xml"));
   EXPECT_EQ(e.rfind(": character: expected an existing file (relative to the task file), but ", 0), 0u) << e;
