@@ -42,7 +42,7 @@ struct RunArgs {
   std::string vary = "control";
   double shape_weight = kDefaultShapeWeight;
   double k = 10.0;
-  long long generations = 500;
+  long long generations = 0;  // 0 = the task's (diversity.generations, default 500)
   std::string strategy = "round-robin";
   std::string constraints = "dominant";
   std::string point = "best-sample";
@@ -89,8 +89,9 @@ void install_run(CLI::App& app) {
   cmd->add_option("--k", args->k, "Weight K of the dmin term (paper: 10)")
       ->capture_default_str()
       ->check(number_in(0, 1e9));
-  cmd->add_option("--generations", args->generations, "Generation limit")
-      ->capture_default_str()
+  cmd->add_option("--generations", args->generations,
+                  "Generation limit (default: the task's [diversity] generations, 500 unless "
+                  "it says)")
       ->check(integer_in(1, kMaxGenerations));
   cmd->add_option("--strategy", args->strategy, "round-robin, progressive, joint or simultaneous")
       ->capture_default_str();
@@ -148,8 +149,8 @@ void install_run(CLI::App& app) {
   add_rank_timeout(cmd, &args->rank_timeout);
   cmd->callback([args] {
     const RunArgs& a = *args;
-    // Ranges are checked by the options' validators (options.h); n = 0 and sigma0 = 0
-    // (never accepted from the command line) stand for the task's own values.
+    // Ranges are checked by the options' validators (options.h); n = 0, sigma0 = 0 and
+    // generations = 0 (never accepted from the command line) stand for the task's own values.
     if (a.vary != "control" && a.vary != "shape")
       throw UserError("--vary: expected control or shape, got '" + a.vary + "'");
     if (!a.metric.empty()) parse_distance(a.metric, a.shape_weight);

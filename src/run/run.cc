@@ -64,6 +64,8 @@ RunSetup make_setup(const std::string& task_path, const std::string& metric_name
   setup.options = options;
   if (setup.options.variations == 0) setup.options.variations = task.variations;
   if (setup.options.sigma0 == 0.0) setup.options.sigma0 = task.diversity.sigma0;
+  if (setup.options.max_generations == 0)
+    setup.options.max_generations = task.diversity.generations;
   if (!fs::exists(task.m0))
     throw UserError(task.file + ": m0: " + task.m0 +
                     " does not exist (create it with `diverse seed-motion " + task.name + "`)");

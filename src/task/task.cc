@@ -238,8 +238,9 @@ void read_seed(const TomlReader& r, Task& task) {
 }
 
 void read_diversity(const TomlReader& r, Task& task) {
-  r.only({"sigma0"});
+  r.only({"sigma0", "generations"});
   task.diversity.sigma0 = r.number("sigma0", 1e-4, 1, task.diversity.sigma0);
+  task.diversity.generations = r.integer("generations", 1, 1000000, task.diversity.generations);
 }
 
 }  // namespace

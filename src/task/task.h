@@ -143,6 +143,8 @@ struct TaskDiversity {
   // thin (the backflip) needs a smaller one, or no sample of the first generations
   // meets the task.
   double sigma0 = 0.1;
+  // Generations of `diverse run` unless `--generations` says otherwise.
+  long long generations = 500;
 };
 
 struct Task {

@@ -18,6 +18,7 @@
 #include "io/motion_record.h"
 #include "run/run.h"
 #include "support/scratch.h"
+#include "support/task_variant.h"
 
 namespace diverse {
 namespace {
@@ -114,6 +115,24 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
 // generation (round-robin at best samples, simultaneous), or one per variation and
 // generation (round-robin at means, each batch but a generation's first with the
 // previous variation's new mean, and that last mean alone at the generation's end).
+// Without --generations a run takes the task's budget ([diversity] generations); the
+// option overrides it.
+TEST(Run, TheTasksGenerationBudgetUnlessTheOptionSaysOtherwise) {
+  const fs::path task =
+      test_files::task_variant("jump_high", "three_generations", {}, {{"diversity", "generations = 3"}});
+  const std::string common =
+      task.string() + " --n 2 --popsize 8 --sigma0 0.01 --seed 3 --quiet --no-render --threads 2";
+  const fs::path own = scratch("budget_task"), given = scratch("budget_option");
+  Result a = run_cli("run " + common + " --out " + own.string());
+  ASSERT_EQ(a.status, 0) << a.output;
+  Result b = run_cli("run " + common + " --generations 2 --out " + given.string());
+  ASSERT_EQ(b.status, 0) << b.output;
+  const auto sa = read_json(own / "summary.json");
+  const auto sb = read_json(given / "summary.json");
+  EXPECT_EQ(sa["evaluations"], 1 + 3 * 2 * 8);
+  EXPECT_EQ(sb["evaluations"], 1 + 2 * 2 * 8);
+}
+
 TEST(Run, TimingHoldsTheRolloutsAndTheStrategysBatches) {
   struct Case {
     const char* options;

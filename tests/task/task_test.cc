@@ -159,6 +159,9 @@ TEST_F(TaskFileTest, ValidTextParses) {
   EXPECT_DOUBLE_EQ(t.constraints.landing_center, 1.0);
   EXPECT_DOUBLE_EQ(t.simulation.settle_time, 1.0);
   EXPECT_DOUBLE_EQ(t.diversity.sigma0, 0.1);  // the default without a [diversity] table
+  EXPECT_EQ(t.diversity.generations, 500);
+  EXPECT_EQ(load_task(write(valid_text() + "[diversity]\ngenerations = 200\n")).diversity.generations,
+            200);
   EXPECT_DOUBLE_EQ(load_task(write(valid_text() + "[diversity]\nsigma0 = 0.03\n")).diversity.sigma0,
                    0.03);
 }
@@ -191,6 +194,8 @@ TEST_F(TaskFileTest, OutOfRange) {
             ": metric: expected \"hf\", \"md\" or \"wja\", got \"xyz\"");
   EXPECT_EQ(error_of(valid_text() + "[diversity]\nsigma0 = 2\n"),
             ": diversity.sigma0: expected a number in [0.0001, 1], got 2");
+  EXPECT_EQ(error_of(valid_text() + "[diversity]\ngenerations = 0\n"),
+            ": diversity.generations: expected an integer in [1, 1000000], got 0");
   const std::string unknown = error_of(valid_text() + "[diversity]\nlambda = 8\n");
   EXPECT_EQ(unknown.rfind(": diversity.lambda: expected no such key", 0), 0u) << unknown;
 }
