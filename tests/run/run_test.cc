@@ -119,7 +119,7 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
 // option overrides it.
 TEST(Run, TheTasksGenerationBudgetUnlessTheOptionSaysOtherwise) {
   const fs::path task =
-      test_files::task_variant("jump_high", "three_generations", {}, {{"diversity", "generations = 3"}});
+      test_files::task_variant("jump_forward", "three_generations", {}, {{"diversity", "generations = 3"}});
   const std::string common =
       task.string() + " --n 2 --popsize 8 --sigma0 0.01 --seed 3 --quiet --no-render --threads 2";
   const fs::path own = scratch("budget_task"), given = scratch("budget_option");
