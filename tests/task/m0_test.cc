@@ -199,26 +199,31 @@ TEST(M0Specifics, JumpOverClearsAndGoesFarEnough) {
   EXPECT_GE(r.e.summary.touchdown_feet_x, 1.0);
 }
 
+// Where six rollouts of a task's M0 moved by 1e-5 in the normalized parameters put the
+// feet: the largest minus the smallest x, at the first touch-down or where they come to rest.
+double spread_of_nudged_m0(const Task& t, bool at_rest) {
+  const TaskEvaluator ev(t);
+  const Eigen::VectorXd x = ev.load_parameters(t.m0).normalized();
+  auto worker = ev.make_worker();
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  double lo = INFINITY, hi = -INFINITY;
+  for (const Eigen::VectorXd& y : perturb(x, 1e-5, 6, 12345)) {
+    const Evaluation e = ev.evaluate_normalized(y, *worker, options);
+    const double feet = at_rest ? e.summary.feet_x : e.summary.touchdown_feet_x;
+    lo = std::min(lo, feet);
+    hi = std::max(hi, feet);
+  }
+  return hi - lo;
+}
+
 // The backflip runs at 2 ms with stable PD for saturated joints. Its input motion found
 // with the explicit way (tests/task/data/backflip_explicit.toml) had to run at 1 ms: at
 // 2 ms its hips chattered between their limits in the air, and parameters 1e-5 apart came
 // to rest up to 11 cm apart (4 mm at 1 ms). The committed one at 2 ms: within 0.1 mm.
 TEST(M0Specifics, BackflipChangesSmoothlyAtItsTimestep) {
   REQUIRE_M0("backflip");
-  auto spread = [](const Task& t) {
-    const TaskEvaluator ev(t);
-    const Eigen::VectorXd x = ev.load_parameters(t.m0).normalized();
-    auto worker = ev.make_worker();
-    EvaluationOptions options;
-    options.samples_per_phase = 0;
-    double lo = INFINITY, hi = -INFINITY;
-    for (const Eigen::VectorXd& y : perturb(x, 1e-5, 6, 12345)) {
-      const Evaluation e = ev.evaluate_normalized(y, *worker, options);
-      lo = std::min(lo, e.summary.feet_x);
-      hi = std::max(hi, e.summary.feet_x);
-    }
-    return hi - lo;
-  };
+  auto spread = [](const Task& t) { return spread_of_nudged_m0(t, true); };
   const Task task = load_task(kTasks + "backflip.toml");
   ASSERT_EQ(task.simulation.saturated_drive, SaturatedDrive::kStablePd);
   ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
@@ -239,20 +244,7 @@ TEST(M0Specifics, BackflipChangesSmoothlyAtItsTimestep) {
 // 1 ms (measured: 0.3 mm at 2 ms under stable PD; the explicit one 6 cm at 2 ms, 3 mm at 1 ms).
 TEST(M0Specifics, JumpOverChangesSmoothlyAtItsTimestep) {
   REQUIRE_M0("jump_over");
-  auto spread = [](const Task& t) {
-    const TaskEvaluator ev(t);
-    const Eigen::VectorXd x = ev.load_parameters(t.m0).normalized();
-    auto worker = ev.make_worker();
-    EvaluationOptions options;
-    options.samples_per_phase = 0;
-    double lo = INFINITY, hi = -INFINITY;
-    for (const Eigen::VectorXd& y : perturb(x, 1e-5, 6, 12345)) {
-      const Evaluation e = ev.evaluate_normalized(y, *worker, options);
-      lo = std::min(lo, e.summary.touchdown_feet_x);
-      hi = std::max(hi, e.summary.touchdown_feet_x);
-    }
-    return hi - lo;
-  };
+  auto spread = [](const Task& t) { return spread_of_nudged_m0(t, false); };
   const Task task = load_task(kTasks + "jump_over.toml");
   ASSERT_EQ(task.simulation.saturated_drive, SaturatedDrive::kStablePd);
   ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
