@@ -217,24 +217,36 @@ double spread_of_nudged_m0(const Task& t, bool at_rest) {
   return hi - lo;
 }
 
+// A task that runs at 2 ms under stable PD (`saturated_drive = "stable_pd"`): nudges of its
+// M0 put the feet (where they come to rest, or where they touch down) within `smooth` of
+// each other; the input motion it had before, found the explicit way at 1 ms
+// (tests/task/data/<name>_explicit.toml), within `smooth_1ms` at 1 ms and beyond `chaotic`
+// at 2 ms.
+struct Smoothness {
+  bool at_rest;
+  double smooth, smooth_1ms, chaotic;  // m
+};
+void expect_smooth_at_2ms_under_stable_pd(const std::string& name, const Smoothness& s) {
+  const Task task = load_task(kTasks + name + ".toml");
+  ASSERT_EQ(task.simulation.saturated_drive, SaturatedDrive::kStablePd);
+  ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
+  EXPECT_LT(spread_of_nudged_m0(task, s.at_rest), s.smooth);
+  Task explicit_way =
+      load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/" + name + "_explicit.toml");
+  ASSERT_EQ(explicit_way.simulation.saturated_drive, SaturatedDrive::kExplicit);
+  ASSERT_EQ(explicit_way.simulation.timestep, 0.001);
+  EXPECT_LT(spread_of_nudged_m0(explicit_way, s.at_rest), s.smooth_1ms);
+  explicit_way.simulation.timestep = 0.002;
+  EXPECT_GT(spread_of_nudged_m0(explicit_way, s.at_rest), s.chaotic);
+}
+
 // The backflip runs at 2 ms with stable PD for saturated joints. Its input motion found
 // with the explicit way (tests/task/data/backflip_explicit.toml) had to run at 1 ms: at
 // 2 ms its hips chattered between their limits in the air, and parameters 1e-5 apart came
 // to rest up to 11 cm apart (4 mm at 1 ms). The committed one at 2 ms: within 0.1 mm.
 TEST(M0Specifics, BackflipChangesSmoothlyAtItsTimestep) {
   REQUIRE_M0("backflip");
-  auto spread = [](const Task& t) { return spread_of_nudged_m0(t, true); };
-  const Task task = load_task(kTasks + "backflip.toml");
-  ASSERT_EQ(task.simulation.saturated_drive, SaturatedDrive::kStablePd);
-  ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
-  EXPECT_LT(spread(task), 0.005);
-  Task explicit_way =
-      load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/backflip_explicit.toml");
-  ASSERT_EQ(explicit_way.simulation.saturated_drive, SaturatedDrive::kExplicit);
-  ASSERT_EQ(explicit_way.simulation.timestep, 0.001);
-  EXPECT_LT(spread(explicit_way), 0.01);
-  explicit_way.simulation.timestep = 0.002;
-  EXPECT_GT(spread(explicit_way), 0.05);
+  expect_smooth_at_2ms_under_stable_pd("backflip", {true, 0.005, 0.01, 0.05});
 }
 
 // jump_over runs at the planar human's 2 ms with stable PD for saturated joints. Its input
@@ -244,18 +256,7 @@ TEST(M0Specifics, BackflipChangesSmoothlyAtItsTimestep) {
 // 1 ms (measured: 0.3 mm at 2 ms under stable PD; the explicit one 6 cm at 2 ms, 3 mm at 1 ms).
 TEST(M0Specifics, JumpOverChangesSmoothlyAtItsTimestep) {
   REQUIRE_M0("jump_over");
-  auto spread = [](const Task& t) { return spread_of_nudged_m0(t, false); };
-  const Task task = load_task(kTasks + "jump_over.toml");
-  ASSERT_EQ(task.simulation.saturated_drive, SaturatedDrive::kStablePd);
-  ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
-  EXPECT_LT(spread(task), 0.005);
-  Task explicit_way =
-      load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_over_explicit.toml");
-  ASSERT_EQ(explicit_way.simulation.saturated_drive, SaturatedDrive::kExplicit);
-  ASSERT_EQ(explicit_way.simulation.timestep, 0.001);
-  EXPECT_LT(spread(explicit_way), 0.005);
-  explicit_way.simulation.timestep = 0.002;
-  EXPECT_GT(spread(explicit_way), 0.02);
+  expect_smooth_at_2ms_under_stable_pd("jump_over", {false, 0.005, 0.005, 0.02});
 }
 
 // The 3D human jumps backwards: the feet come down within 25 cm of the spot 0.8 m behind
