@@ -269,6 +269,12 @@ const duration = () => Math.max(1e-6, ...tiles.map((t) => shownTrack(t).duration
 
 // ---------------------------------------------------------------- three.js scene
 
+// The panels that need no WebGL (header, distances, robustness shares, plots) are filled
+// before the scene is made, so that a browser without WebGL still shows them.
+fillHeader();
+fillDistances();
+fillPlots(data, $);
+
 const canvas = $('view');
 let renderer;
 try {
@@ -276,6 +282,7 @@ try {
 } catch (e) {
   $('webgl-error').hidden = false;
   $('stage').hidden = true;
+  $('transport').hidden = true;
   throw e;
 }
 renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
@@ -896,10 +903,7 @@ function frame(now) {
   requestAnimationFrame(frame);
 }
 
-fillHeader();
-fillDistances();
 fillBlends();
-fillPlots(data, $);
 $('play').textContent = playing ? 'Pause' : 'Play';
 new ResizeObserver(requestRender).observe($('stage'));
 window.addEventListener('scroll', requestRender, { passive: true });

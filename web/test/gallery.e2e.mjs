@@ -21,7 +21,8 @@
 // the test computes it), marked as meeting the task or not as its constraint says; two
 // corners of the simplex show different pictures. Writes RUN_DIR/gallery-screenshot.png, plots-screenshot.png and
 // gltf-screenshot.png. Every motion shows its shares of the robustness suite (robustness.json
-// or summary.json), or, for a run without them, that the suite was not run. Chromium:
+// or summary.json), or, for a run without them, that the suite was not run. With WebGL
+// turned off the page says so and still shows its header, distance table and plots. Chromium:
 // $CHROMIUM or /usr/bin/chromium.
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -499,6 +500,55 @@ try {
 } finally {
   await context.close();
   rmSync(userDataDir, { recursive: true, force: true });
+}
+
+// ---------------------------------------------------------------- without WebGL
+
+// A browser with WebGL turned off gets the page's message instead of the views, and still
+// the header, the distance table with the robustness shares, and the plots.
+const plainDir = mkdtempSync(join(tmpdir(), 'diverse-e2e-chromium-'));
+const plain = await chromium.launchPersistentContext(plainDir, {
+  executablePath,
+  headless: true,
+  viewport: { width: 1400, height: 1100 },
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-3d-apis', '--no-first-run',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+try {
+  const page = await plain.newPage();
+  const pageErrors = [];
+  page.on('pageerror', (e) => pageErrors.push(e.message));
+  await page.goto(pathToFileURL(join(runDir, 'gallery.html')).href);
+  await page.waitForSelector('#webgl-error:not([hidden])', { timeout: 30000 });
+  const shown = await page.evaluate(() => {
+    const data = JSON.parse(document.getElementById('gallery-data').textContent);
+    return {
+      task: data.task,
+      motions: data.motions.length,
+      robustness: Boolean(data.robustness),
+      progress: (data.progress?.generation || []).length > 0,
+      title: document.getElementById('title').textContent,
+      distances: !document.getElementById('distance-panel').hidden,
+      rows: document.querySelectorAll('#distances tr').length,
+      robust: [...document.querySelectorAll('#distances td.robust')].map((t) => t.textContent),
+      plotD: document.querySelectorAll('#plot-d svg').length,
+      heatmaps: document.querySelectorAll('#heatmaps .heatmap-box').length,
+      stageHidden: document.getElementById('stage').hidden,
+      transportHidden: document.getElementById('transport').hidden,
+    };
+  });
+  check(shown.stageHidden && shown.transportHidden, 'without WebGL: the page says so and hides the views and their playback');
+  check(shown.title === shown.task, 'without WebGL: the header names the task', shown.title);
+  check(!shown.distances || shown.rows === shown.motions + 1, 'without WebGL: the distance table has a row per motion',
+    `${shown.rows} rows`);
+  check(!shown.robustness || shown.robust.length === shown.motions,
+    'without WebGL: every motion\'s robustness share is in the table', shown.robust.join(', '));
+  check(!shown.progress || shown.plotD === 1, 'without WebGL: the plots are drawn', `${shown.plotD} D plots`);
+  check(!shown.distances || shown.heatmaps > 0, 'without WebGL: the distance heatmaps are drawn', `${shown.heatmaps}`);
+  check(pageErrors.length === 1, 'without WebGL: the one error is the failed WebGL context', pageErrors.join(' | '));
+} finally {
+  await plain.close();
+  rmSync(plainDir, { recursive: true, force: true });
 }
 
 console.log(`gallery e2e: ${passed} passed, ${failed} failed`);
