@@ -2,7 +2,8 @@
 // simulated fresh: each walks its 30 steps without a fall and meets its task (C = 0) at
 // the task's timestep and at half of it, keeps every net joint torque (motor plus
 // damping) within its limit at every step, replays exactly, and some of its
-// neighbourhood in parameter space meets the task too.
+// neighbourhood in parameter space meets the task too; at its task's coarser step it is the
+// walk it is at 1 ms.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -95,8 +96,8 @@ TEST(WalkM0, WalksAtItsTimestepAsAt1ms) {
 }
 
 // Half or more of the input walks' perturbations at a normalized step of 0.02 meet the task,
-// at both timesteps (the committed walks: 24 and 17 of 32 at their timesteps; `diverse seed-motion TASK
-// --robustness-check`).
+// at both timesteps (the committed walks at their tasks' steps: 24 and 17 of 32; `diverse
+// seed-motion TASK --robustness-check`).
 TEST(WalkM0, HalfOfTheNeighbourhoodMeetsTheTask) {
   for (const char* name : {"silly_walk", "robot_silly_walk"}) {
     const Task task = load_task(kTasks + name + std::string(".toml"));
