@@ -156,7 +156,8 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_hei
 // The plug-in.
 
 std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const TomlReader& r) const {
-  r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd", "asymmetric"});
+  r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd", "asymmetric", "yaw_kp",
+          "yaw_kd", "neck_attitude_kp", "neck_attitude_kd", "land_swing_placement"});
   auto c = std::make_shared<Jump3dControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -164,6 +165,11 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const 
   c->com_kp = r.number("com_kp", 0, 500, c->com_kp);
   c->com_kd = r.number("com_kd", 0, 100, c->com_kd);
   c->asymmetric = r.boolean("asymmetric", c->asymmetric);
+  c->yaw_kp = r.number("yaw_kp", 0, 5000, c->yaw_kp);
+  c->yaw_kd = r.number("yaw_kd", 0, 1000, c->yaw_kd);
+  c->neck_attitude_kp = r.number("neck_attitude_kp", 0, 10, c->neck_attitude_kp);
+  c->neck_attitude_kd = r.number("neck_attitude_kd", 0, 2, c->neck_attitude_kd);
+  c->land_swing_placement = r.boolean("land_swing_placement", c->land_swing_placement);
   return c;
 }
 
@@ -254,6 +260,7 @@ Jump3dController::Jump3dController(const Character& body, const Jump3dController
   ankle_ = l.ankle;
   foot_group_ = l.foot;
   chest_ = l.chest;
+  neck_ = body.find_group(JointRole::kNeck, JointPlane::kSagittal);
   posed_ = l.posed;
   pose_slot_.assign(body.groups.size(), -1);
   for (size_t k = 0; k < posed_.size(); ++k) pose_slot_[static_cast<size_t>(posed_[k])] = static_cast<int>(k);
@@ -331,6 +338,8 @@ void Jump3dController::reset(const mjModel* m, const mjData* d) {
   StanceGains gains;
   gains.com_kp = config_.com_kp;
   gains.com_kd = config_.com_kd;
+  gains.yaw_kp = config_.yaw_kp;
+  gains.yaw_kd = config_.yaw_kd;
   stance_ = std::make_unique<StanceController>(body_, m, gains);
   gravity_ = -m->opt.gravity[2];
   const size_t n = body_.joints.size();
@@ -486,18 +495,28 @@ void Jump3dController::landing_hips(const mjData* d, std::vector<double>& target
   const double t_cross = (vz + std::sqrt(vz * vz + 2 * gravity_ * z)) / gravity_;
   const double f[2] = {std::cos(heading_), std::sin(heading_)};
   const double lat[2] = {-f[1], f[0]};
+  std::array<std::array<double, 2>, 2> goals{};
+  for (int s = 0; s < 2; ++s) {
+    const LegGeometry& leg = legs_[static_cast<size_t>(s)];
+    for (int i = 0; i < 2; ++i) {
+      goals[static_cast<size_t>(s)][static_cast<size_t>(i)] =
+          com_[static_cast<size_t>(i)] + com_vel_[static_cast<size_t>(i)] * t_cross +
+          landing_offset_[static_cast<size_t>(s)] * f[i] +
+          landing_velocity_gain_[static_cast<size_t>(s)] * com_vel_[static_cast<size_t>(i)] + leg.lateral * lat[i];
+    }
+  }
+  point_legs(d, goals, {true, true}, targets);
+}
+
+void Jump3dController::point_legs(const mjData* d, const std::array<std::array<double, 2>, 2>& goals,
+                                  const std::array<bool, 2>& which, std::vector<double>& targets) const {
   const int root = body_.root_body;
   std::array<double, 4> root_inv{d->xquat[4 * root], -d->xquat[4 * root + 1], -d->xquat[4 * root + 2],
                                  -d->xquat[4 * root + 3]};
   for (int s = 0; s < 2; ++s) {
+    if (!which[static_cast<size_t>(s)]) continue;
     const LegGeometry& leg = legs_[static_cast<size_t>(s)];
-    double goal[2];
-    for (int i = 0; i < 2; ++i) {
-      goal[i] = com_[static_cast<size_t>(i)] + com_vel_[static_cast<size_t>(i)] * t_cross +
-                landing_offset_[static_cast<size_t>(s)] * f[i] +
-                landing_velocity_gain_[static_cast<size_t>(s)] * com_vel_[static_cast<size_t>(i)] +
-                leg.lateral * lat[i];
-    }
+    const double* goal = goals[static_cast<size_t>(s)].data();
     // The leg (hip to foot joint) with the joints between at their targets, in the root's
     // frame with the hip at its reference angles: s0 + R1 (s1 + R2 (s2 + ...)).
     Vec3 v = leg.segments.back();
@@ -570,10 +589,27 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   const size_t n = body_.joints.size();
 
   if (is_stance(phase_)) {
+    for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
+    if (phase_ == kLand && config_.land_swing_placement && !(contacts.foot[0] && contacts.foot[1])) {
+      // A leg off the ground while landing points at the COM's capture point (plus its
+      // standing sideways offset) instead of holding its hip angles of the touch-down,
+      // which the body's turn toward its landing pitch would swing away.
+      const double height = std::max(com_[2] - config_.landing_height_m, 0.1);
+      const double t_capture = std::sqrt(height / gravity_);
+      const double lat[2] = {-std::sin(heading_), std::cos(heading_)};
+      std::array<std::array<double, 2>, 2> goals{};
+      for (int side = 0; side < 2; ++side) {
+        for (int i = 0; i < 2; ++i) {
+          goals[static_cast<size_t>(side)][static_cast<size_t>(i)] =
+              com_[static_cast<size_t>(i)] + t_capture * com_vel_[static_cast<size_t>(i)] +
+              legs_[static_cast<size_t>(side)].lateral * lat[i];
+        }
+      }
+      point_legs(d, goals, {!contacts.foot[0], !contacts.foot[1]}, target_);
+    }
     stance_->set_pitches(from_.root + s * (goal_.root - from_.root), from_.torso + s * (goal_.torso - from_.torso),
                          {from_.foot[0] + s * (goal_.foot[0] - from_.foot[0]),
                           from_.foot[1] + s * (goal_.foot[1] - from_.foot[1])});
-    for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
     stance_->set_targets(target_);
     stance_->control(m, d, drive);
     return;
@@ -611,6 +647,18 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
           roll = (1 - w) * hips[static_cast<size_t>(2 * side + 1)] + w * roll;
         }
       }
+    }
+  }
+  if (neck_ >= 0 && (config_.neck_attitude_kp > 0 || config_.neck_attitude_kd > 0)) {
+    // The head as a reaction mass: the root's backward pitch beyond the landing's target
+    // (and its rate) swings the head back, which turns the body forward, and the other way.
+    const double error = stance_->measured_pitches(d).root - pose_[kLand][static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])][0];
+    const double* w = d->cvel + 6 * root;
+    const double rate = -(-std::sin(heading_) * w[0] + std::cos(heading_) * w[1]);  // backwards
+    const double turn = config_.neck_attitude_kp * error + config_.neck_attitude_kd * rate;
+    for (int k : body_.groups[static_cast<size_t>(neck_)].joints) {
+      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+      target_[static_cast<size_t>(k)] = clamp_to_range(j, qpos0_[static_cast<size_t>(k)] + turn);
     }
   }
   const auto& kp = kp_[static_cast<size_t>(phase_)];

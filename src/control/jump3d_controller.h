@@ -105,6 +105,15 @@ struct Jump3dControllerConfig : ControllerConfig {
   double airborne_time = 0.01;   // s without contact (COM rising) that counts as take-off
   double com_kp = 40, com_kd = 12;  // 1/s^2, 1/s: the stance phases' horizontal COM servo
   bool asymmetric = false;       // left and right of every pair have their own parameters
+  // Nm/rad, Nm s/rad: the stance phases hold the root's yaw with two stance legs (0, 0: not
+  // held; StanceGains::yaw_kp, yaw_kd)
+  double yaw_kp = 0, yaw_kd = 0;
+  // rad/rad, s: in flight the sagittal neck turns back by kp times the root's backward
+  // pitch beyond the land phase's target plus kd times its backward pitch rate (0, 0: the
+  // neck holds its standing pose)
+  double neck_attitude_kp = 0, neck_attitude_kd = 0;
+  // in land, a leg whose foot is off the ground points at the COM's capture point
+  bool land_swing_placement = false;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -171,10 +180,15 @@ class Jump3dController : public Controller {
   void enter(int phase, const mjModel* m, const mjData* d);
   void measure_pitches(const mjData* d, StanceTargets& out) const;
   void landing_hips(const mjData* d, std::vector<double>& targets) const;
+  // Sets the hip targets of the legs in `which` so that each points at its goal (world x, y
+  // on the ground), with the joints between hip and foot at their targets.
+  void point_legs(const mjData* d, const std::array<std::array<double, 2>, 2>& goals,
+                  const std::array<bool, 2>& which, std::vector<double>& targets) const;
 
   const Character& body_;
   Jump3dControllerConfig config_;
   int hip_ = -1, knee_ = -1, ankle_ = -1, foot_group_ = -1, chest_ = -1;  // group indices
+  int neck_ = -1;  // the sagittal neck group, or -1
   std::vector<int> posed_;       // parameterized groups, in parameter order
   std::vector<int> pose_slot_;   // per group: index into posed_, or -1
   std::vector<int> gain_slot_;   // per group: 0 hip, 1 knee, 2 ankle, -1 default gains

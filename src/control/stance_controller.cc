@@ -482,6 +482,31 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       leg_cop_[static_cast<size_t>(s)] = {f[0] + residual[0], f[1] + residual[1], sole};
     }
     load_ = load;
+
+    // Yaw: equal and opposite pushes of the two legs at right angles to the line between
+    // their centres of pressure, a moment about the vertical and no net force.
+    yaw_force_ = 0;
+    if (legs == 2 && (gains_.yaw_kp > 0 || gains_.yaw_kd > 0)) {
+      const auto& cl = leg_cop_[0];
+      const auto& cr = leg_cop_[1];
+      const double dx = cl[0] - cr[0], dy = cl[1] - cr[1];
+      const double width = std::hypot(dx, dy);
+      if (width > 0.05) {
+        double e[3];
+        rotation_error(root_target_.data(), d->xquat + 4 * root, e);
+        const double wz = d->cvel[6 * root + 2];
+        const double moment = gains_.yaw_kp * e[2] - gains_.yaw_kd * wz;
+        const double limit = 0.25 * fz;
+        const double yaw = std::clamp(moment / width, -limit, limit);
+        const double nx = -dy / width, ny = dx / width;
+        for (int s = 0; s < 2; ++s) {
+          const double sign = s == 0 ? 1.0 : -1.0;
+          leg_force_[static_cast<size_t>(s)][0] += sign * yaw * nx;
+          leg_force_[static_cast<size_t>(s)][1] += sign * yaw * ny;
+        }
+        yaw_force_ = yaw;
+      }
+    }
   }
 
   // Default: PD toward the targets, gravity compensation off the stance legs.

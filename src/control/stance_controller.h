@@ -52,6 +52,18 @@
 //   just the hip) leaves the legs' sideways sway, which does not turn the root, to the COM
 //   force alone. The hips get only these torques; the knees (and the bird's ankles) add
 //   them to their PD toward the targets.
+// - Yaw (StanceGains::yaw_kp, yaw_kd; off by default). A universal hip cannot turn the
+//   root about its missing axis, but two stance legs can, by pushing unequally along the
+//   line at right angles to the one between their centres of pressure: with d = cop_l -
+//   cop_r (horizontal) and n = z x d / |d|, the left leg adds D n and the right -D n, a
+//   moment |d| D about the vertical and no net force, so the COM force and its centre of
+//   pressure stay as they were. D = (yaw_kp e_z - yaw_kd w_z) / |d| (e_z the vertical part
+//   of the root's rotation error, w_z its angular velocity about the vertical), at most a
+//   quarter of F_z, which leaves each foot's horizontal force well inside the friction
+//   cone. Like the COM force it becomes joint torques of the stance legs, tau = J^T.
+//   Without it a jump's take-off and landing keep whatever spin the legs' unequal pushes
+//   give the body: a bird-robot jump whose left and right parameters differ by 0.5 % of
+//   their ranges turned up to 1 rad about the vertical before it landed.
 // - Feet. The hinges of each foot body keep the sole flat: they track the rotation that
 //   turns the foot's standing "up" to world up, tau = a . (kp e_foot) - kd (a . w_foot),
 //   with the foot group's gains, plus the J^T terms in stance.
@@ -89,6 +101,10 @@ struct StanceGains {
   double root_kd = 0;                // Nm s/rad; 0: root_kp / 10 s
   double cop_margin = 0.02;          // m, the centre of pressure stays this far inside the support
   bool gravity_compensation = true;  // on the joints off the stance legs
+  // The root's yaw with two stance legs (Nm/rad, Nm s/rad; 0 and 0: not held, the default).
+  // See "Yaw" above.
+  double yaw_kp = 0;
+  double yaw_kd = 0;
 };
 
 class StanceController {
@@ -161,6 +177,8 @@ class StanceController {
   const std::array<double, 3>& virtual_force() const { return force_; }
   const std::array<double, 2>& support_centre() const { return support_; }
   const std::array<bool, 2>& stance() const { return stance_; }
+  // The yaw push D of the last control() (N; 0 when yaw is not held or one leg stands).
+  double yaw_push() const { return yaw_force_; }
   // Each stance foot's share of the vertical force (sums to 1 in stance).
   const std::array<double, 2>& load() const { return load_; }
   double mass() const { return mass_; }
@@ -214,6 +232,7 @@ class StanceController {
   std::array<double, 2> load_{0, 0};
   std::array<std::array<double, 3>, 2> leg_force_{};  // N, the virtual force of each leg
   std::array<std::array<double, 3>, 2> leg_cop_{};    // m, where it acts (on the ground)
+  double yaw_force_ = 0;                               // N, the yaw push D (left +, right -)
   std::vector<double> u_, kd_;
 };
 

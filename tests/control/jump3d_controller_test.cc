@@ -106,7 +106,8 @@ TEST(Jump3dController, ReadsItsOwnKeysStrictly) {
   } catch (const UserError& e) {
     EXPECT_EQ(std::string(e.what()), path + ": controller.bounce: expected no such key (unknown key; known keys: "
                                             "type, landing_control, landing_height, extend_timeout, com_kp, com_kd, "
-                                            "asymmetric)");
+                                            "asymmetric, yaw_kp, yaw_kd, neck_attitude_kp, neck_attitude_kd, "
+                                            "land_swing_placement)");
   }
 }
 

@@ -1,0 +1,114 @@
+// The feedback options of "jump3d" that hold a bird-robot jump whose left and right
+// parameters differ (control/jump3d_controller.h): the stance legs hold the body's yaw, the
+// head turns the body toward its landing pitch in flight. Each is checked on what it does
+// to the body: perturbations of the robot's input motion (every normalized parameter moved
+// by sigma 0.005, left and right apart) touch down turned less about the vertical, and
+// pitched nearer their landing target, than without the option; and the input motion,
+// mirror-symmetric, is not changed by the yaw hold.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "control/jump3d_controller.h"
+#include "task/evaluate.h"
+#include "task/seed_motion.h"
+
+namespace diverse {
+namespace {
+
+const std::string kRoot = DIVERSE_SOURCE_DIR;
+
+// The robot's jump task with its controller's options changed by `edit`.
+template <typename Edit>
+Task robot_jump_with(Edit edit) {
+  Task t = load_task(kRoot + "/tasks/robot_jump.toml");
+  auto c = std::make_shared<Jump3dControllerConfig>(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config));
+  c->yaw_kp = c->yaw_kd = c->neck_attitude_kp = c->neck_attitude_kd = 0;
+  c->land_swing_placement = false;
+  edit(*c);
+  t.controller_config = c;
+  return t;
+}
+
+struct Touchdown {
+  bool landed = false;
+  double x = 0;      // m, the feet's mean at touch-down
+  double yaw = 0;    // rad, the root's turn about the vertical
+  double pitch = 0;  // rad, the root's forward axis above level (backwards positive)
+};
+
+Touchdown touchdown(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worker) {
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  const Evaluation e = ev.evaluate_normalized(x, worker, options);
+  Touchdown t;
+  if (!e.has_flight() || e.flight_qpos.empty()) return t;
+  const int nq = ev.model().get()->nq;
+  const double* q = e.flight_qpos.data() + e.flight_qpos.size() - static_cast<size_t>(nq) + ev.body().root_qpos + 3;
+  double R[9];
+  mju_quat2Mat(R, q);
+  t.landed = true;
+  t.x = e.summary.touchdown_feet_x;
+  t.yaw = std::atan2(R[3], R[0]);
+  t.pitch = std::atan2(R[6], std::hypot(R[0], R[3]));
+  return t;
+}
+
+constexpr int kSamples = 6;
+constexpr double kSigma = 0.005;
+
+TEST(Jump3dLanding, HoldingTheYawKeepsAnUnevenJumpFacingAhead) {
+  const TaskEvaluator off(robot_jump_with([](Jump3dControllerConfig&) {}));
+  const TaskEvaluator on(robot_jump_with([](Jump3dControllerConfig& c) {
+    c.yaw_kp = 1000;
+    c.yaw_kd = 200;
+  }));
+  auto worker_off = off.make_worker();
+  auto worker_on = on.make_worker();
+  const Eigen::VectorXd x = off.load_parameters(off.task().m0).normalized();
+  // The input motion is mirror-symmetric: nothing to turn, the same jump.
+  const Touchdown m0_off = touchdown(off, x, *worker_off), m0_on = touchdown(on, x, *worker_on);
+  ASSERT_TRUE(m0_off.landed && m0_on.landed);
+  EXPECT_NEAR(m0_on.x, m0_off.x, 1e-3);
+  EXPECT_NEAR(m0_on.yaw, 0, 1e-3);
+  double turn_off = 0, turn_on = 0;
+  for (const Eigen::VectorXd& y : perturb(x, kSigma, kSamples, robustness_seed(off.task(), kSigma))) {
+    const Touchdown a = touchdown(off, y, *worker_off), b = touchdown(on, y, *worker_on);
+    if (!a.landed || !b.landed) continue;
+    turn_off += std::fabs(a.yaw) / kSamples;
+    turn_on += std::fabs(b.yaw) / kSamples;
+  }
+  EXPECT_GT(turn_off, 0.2) << "the perturbations turn the body without the yaw hold";
+  EXPECT_LT(turn_on, 0.5 * turn_off) << "mean |yaw| at touch-down: " << turn_on << " against " << turn_off;
+}
+
+TEST(Jump3dLanding, TheHeadTurnsTheBodyTowardItsLandingPitch) {
+  const auto edit = [](Jump3dControllerConfig& c) {
+    c.yaw_kp = 1000;
+    c.yaw_kd = 200;
+  };
+  const TaskEvaluator off(robot_jump_with(edit));
+  const TaskEvaluator on(robot_jump_with([&](Jump3dControllerConfig& c) {
+    edit(c);
+    c.neck_attitude_kp = 1;
+  }));
+  auto worker_off = off.make_worker();
+  auto worker_on = on.make_worker();
+  const ParameterSet p = off.load_parameters(off.task().m0);
+  const double target = p.get("land.torso");  // the land phase's root pitch
+  const Eigen::VectorXd x = p.normalized();
+  double miss_off = 0, miss_on = 0;
+  for (const Eigen::VectorXd& y : perturb(x, kSigma, kSamples, robustness_seed(off.task(), kSigma))) {
+    const Touchdown a = touchdown(off, y, *worker_off), b = touchdown(on, y, *worker_on);
+    if (!a.landed || !b.landed) continue;
+    miss_off += std::fabs(a.pitch - target) / kSamples;
+    miss_on += std::fabs(b.pitch - target) / kSamples;
+  }
+  EXPECT_LT(miss_on, miss_off - 0.1) << "mean |pitch - target| at touch-down: " << miss_on << " against " << miss_off;
+}
+
+}  // namespace
+}  // namespace diverse
