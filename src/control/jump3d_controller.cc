@@ -11,6 +11,10 @@ namespace diverse {
 namespace {
 
 
+// m: how far along the heading a leg placed again while landing goes from beside the foot
+// still on the ground, toward the COM's capture point.
+constexpr double kSwingReach = 0.2;
+
 bool is_stance(int phase) { return phase == kStart || phase == kCrouch || phase == kExtend || phase == kLand; }
 
 // World-pitch ranges (rad) of the links tracked in stance: root, foot, chest.
@@ -591,19 +595,31 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   if (is_stance(phase_)) {
     for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
     if (phase_ == kLand && config_.land_swing_placement && !(contacts.foot[0] && contacts.foot[1])) {
-      // A leg off the ground while landing points at the COM's capture point (plus its
-      // standing sideways offset) instead of holding its hip angles of the touch-down,
-      // which the body's turn toward its landing pitch would swing away.
+      // A leg off the ground while landing is placed again instead of holding its hip
+      // angles of the touch-down, which the body's turn toward its landing pitch would
+      // swing away: beside the foot still on the ground, moved along the heading toward
+      // the COM's capture point by at most kSwingReach; with both feet off, at the
+      // capture point (each foot at its standing sideways offset).
       const double height = std::max(com_[2] - config_.landing_height_m, 0.1);
       const double t_capture = std::sqrt(height / gravity_);
-      const double lat[2] = {-std::sin(heading_), std::cos(heading_)};
+      const double f[2] = {std::cos(heading_), std::sin(heading_)};
+      const double lat[2] = {-f[1], f[0]};
+      double capture[2];
+      for (int i = 0; i < 2; ++i) capture[i] = com_[static_cast<size_t>(i)] + t_capture * com_vel_[static_cast<size_t>(i)];
+      const int standing = contacts.foot[0] ? 0 : contacts.foot[1] ? 1 : -1;
       std::array<std::array<double, 2>, 2> goals{};
       for (int side = 0; side < 2; ++side) {
-        for (int i = 0; i < 2; ++i) {
-          goals[static_cast<size_t>(side)][static_cast<size_t>(i)] =
-              com_[static_cast<size_t>(i)] + t_capture * com_vel_[static_cast<size_t>(i)] +
-              legs_[static_cast<size_t>(side)].lateral * lat[i];
-        }
+        const double w = legs_[static_cast<size_t>(side)].lateral;
+        for (int i = 0; i < 2; ++i) goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = capture[i] + w * lat[i];
+        if (standing < 0) continue;
+        const int foot = body_.feet[static_cast<size_t>(standing)];
+        const double* joint = d->xpos + 3 * foot;   // the stance foot's joint
+        const double* centre = d->xipos + 3 * foot;  // and its sole's middle
+        const double reach = std::clamp(f[0] * (capture[0] - centre[0]) + f[1] * (capture[1] - centre[1]),
+                                        -kSwingReach, kSwingReach);
+        const double dw = w - legs_[static_cast<size_t>(standing)].lateral;
+        for (int i = 0; i < 2; ++i)
+          goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = joint[i] + reach * f[i] + dw * lat[i];
       }
       point_legs(d, goals, {!contacts.foot[0], !contacts.foot[1]}, target_);
     }

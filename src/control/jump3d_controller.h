@@ -62,6 +62,25 @@
 // side given the shared parameter's value gives the symmetric controller's rollout bit for
 // bit (a stance phase's feet start from their mean measured pitch either way).
 //
+// Feedback options (`[controller]` keys, all off by default; docs/jumps3d.md, "Feedback for
+// the landing"):
+//   yaw_kp, yaw_kd (Nm/rad, Nm s/rad; 0 to 5000, 0 to 1000)  every stance phase holds the
+//           root's yaw with two stance legs: equal and opposite pushes of the legs across
+//           the line between their feet, a moment about the vertical and no net force,
+//           as joint torques tau = J^T F (control/stance_controller.h, "Yaw"). A universal
+//           hip has no yaw hinge; without it an uneven push-off leaves the body spinning.
+//   neck_attitude_kp, neck_attitude_kd (rad/rad, s; 0 to 10, 0 to 2)  in flight the
+//           sagittal neck turns back from its standing angle by kp times the root's
+//           backward pitch beyond the land phase's root target plus kd times its backward
+//           pitch rate (clamped to the joint's range): the head as a reaction mass, which
+//           turns the body toward the pitch it lands with.
+//   land_swing_placement (true/false)  in land, a leg whose foot is off the ground is
+//           pointed again (the landing controller's hip geometry) instead of holding its
+//           hip angles of the touch-down, which the body's turn toward its landing pitch
+//           would swing back and up: beside the foot still on the ground, moved along the
+//           heading toward the COM's capture point x + v sqrt(z / g) by at most 0.2 m; with
+//           both feet off, under the capture point.
+//
 // No external force is ever applied: the root is unactuated and every torque goes through
 // the joint drive (physics/drive.h), which keeps it within the joint's limit on the net
 // torque.

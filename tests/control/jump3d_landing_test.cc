@@ -3,8 +3,9 @@
 // head turns the body toward its landing pitch in flight. Each is checked on what it does
 // to the body: perturbations of the robot's input motion (every normalized parameter moved
 // by sigma 0.005, left and right apart) touch down turned less about the vertical, and
-// pitched nearer their landing target, than without the option; and the input motion,
-// mirror-symmetric, is not changed by the yaw hold.
+// pitched nearer their landing target, than without the option; the input motion,
+// mirror-symmetric, is not changed by the yaw hold; and with every option on, all of it is
+// joint torques within their limits.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "control/jump3d_controller.h"
+#include "physics/drive.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
 
@@ -108,6 +110,36 @@ TEST(Jump3dLanding, TheHeadTurnsTheBodyTowardItsLandingPitch) {
     miss_on += std::fabs(b.pitch - target) / kSamples;
   }
   EXPECT_LT(miss_on, miss_off - 0.1) << "mean |pitch - target| at touch-down: " << miss_on << " against " << miss_off;
+}
+
+// With every option on, a perturbed jump (through flight, touch-down and whatever follows)
+// is driven by joint torques alone, each within its joint's limit on the net torque, on the
+// plain model replaying the recorded inputs.
+TEST(Jump3dLanding, TheOptionsActThroughTheJointDriveAlone) {
+  const TaskEvaluator ev(robot_jump_with([](Jump3dControllerConfig& c) {
+    c.yaw_kp = 1000;
+    c.yaw_kd = 200;
+    c.neck_attitude_kp = 1;
+    c.neck_attitude_kd = 0.1;
+    c.land_swing_placement = true;
+  }));
+  auto worker = ev.make_worker();
+  const Eigen::VectorXd x = ev.load_parameters(ev.task().m0).normalized();
+  const Eigen::VectorXd y = perturb(x, kSigma, 1, robustness_seed(ev.task(), kSigma)).front();
+  StepRecorder record;
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  options.recorder = &record;
+  const Evaluation e = ev.evaluate_normalized(y, *worker, options);
+  ASSERT_TRUE(e.has_flight());
+  mjModel* plain = mj_copyModel(nullptr, ev.model().get());
+  const NetTorqueCheck check = check_net_torque(plain, record, driven_joints(plain));
+  mj_deleteModel(plain);
+  EXPECT_EQ(check.steps, record.steps());
+  EXPECT_LE(check.worst_excess, 0.0);
+  EXPECT_FALSE(check.blew_up);
+  const mjModel* m = ev.model().get();
+  for (int a = 0; a < m->nu; ++a) EXPECT_NE(m->jnt_bodyid[m->actuator_trnid[2 * a]], ev.body().root_body);
 }
 
 }  // namespace
