@@ -46,6 +46,7 @@ struct SeedArgs {
   bool robustness_check = false;
   std::vector<double> check_sigmas{0.02, 0.05};
   int check_samples = 32;
+  bool convergence = false;
   int from_stage = 0;
   double strength = 1.0;
   bool robust = false;
@@ -124,8 +125,10 @@ void check(const SeedArgs& args) {
   const TaskEvaluator ev(task);
   const std::string path = args.start.empty() ? task.m0 : args.start;
   const ParameterSet p = ev.load_parameters(path);
+  if (args.convergence && task.walk.enabled)
+    throw UserError("--convergence: compares where a jump first touches down; " + task.file + " is a walk");
   const RobustnessReport r =
-      measure_robustness(task, p, args.check_sigmas, args.check_samples, args.threads);
+      measure_robustness(task, p, args.check_sigmas, args.check_samples, args.threads, args.convergence);
   std::printf("%s: %s\n", task.name.c_str(), path.c_str());
   std::printf("  C = %.6g at the task's timestep, %.6g with it halved\n", r.constraint,
               r.constraint_fine);
@@ -135,9 +138,23 @@ void check(const SeedArgs& args) {
     std::printf("  landing spots at the two timesteps differ by %.3f m (input motions: at most %.2f m)\n",
                 r.landing_shift, kTimestepAgreement);
   }
+  if (args.convergence) {
+    std::printf("  first touch-down at the task's timestep, half and a quarter of it: x = %.3f, %.3f, %.3f m "
+                "(C = %.6g at a quarter)\n",
+                r.touchdown_x[0], r.touchdown_x[1], r.touchdown_x[2], r.constraint_quarter);
+  }
   for (const RobustnessReport::Level& l : r.levels) {
     std::printf("  sigma %g: %d of %d perturbations meet the task (%.0f %%)\n", l.sigma, l.met,
                 l.samples, 100 * l.fraction());
+    if (!args.convergence) continue;
+    const TimestepConvergence& v = l.convergence;
+    if (v.compared == 0) {
+      std::printf("    touch-downs at three timesteps: none of them touched down at all three\n");
+    } else {
+      std::printf("    touch-downs at the step and half of it %.3f m apart on average (at most %.3f), at half and "
+                  "a quarter %.3f m (at most %.3f); %d of %d compared\n",
+                  v.half_mean, v.half_max, v.quarter_mean, v.quarter_max, v.compared, l.samples);
+    }
   }
   if (args.robust) robust_check(ev, p, args.threads);
 }
@@ -146,6 +163,8 @@ void run(const SeedArgs& args) {
   if (args.objective != "mean" && args.objective != "share")
     throw UserError("--objective: expected mean or share, got '" + args.objective + "'");
   if (args.robustness_check) return check(args);
+  if (args.convergence)
+    throw UserError("--convergence: only with --robustness-check (it measures a motion, it does not search)");
   const Task task = task_at_strength(args);
   const TaskEvaluator ev(task);
   const std::string start_path = args.start.empty() ? task.seed.base : args.start;
@@ -315,6 +334,11 @@ void install(CLI::App& app) {
                   "Robustness check: perturbation sizes, normalized (default 0.02 0.05); each size "
                   "gets the same perturbations whatever the others")
       ->check(number_in(1e-6, 1.0));
+  cmd->add_flag("--convergence", args->convergence,
+                "Robustness check of a jump: also simulate the motion and each perturbation at the "
+                "task's timestep, half and a quarter of it, and say how far apart their first "
+                "touch-downs are; a motion converged in the timestep comes down ever nearer one "
+                "spot as the step shrinks (docs/robustness.md)");
   cmd->add_option("--check-samples", args->check_samples,
                   "Robustness check: perturbations per size (default 32)")
       ->check(integer_in(1, 100000));

@@ -489,8 +489,44 @@ std::uint64_t robustness_seed(const Task& task, double sigma) {
   return derive_seed(task.seed.seed, {kMeasurePerturbations, std::bit_cast<std::uint64_t>(sigma)});
 }
 
+namespace {
+
+// The first touch-downs of x at the task's timestep, half and a quarter of it (m, x and y),
+// and whether all three touched down.
+struct ThreeSteps {
+  bool landed = false;                       // at all three
+  std::array<bool, 3> landed_at{};
+  std::array<std::array<double, 2>, 3> touchdown{};
+  std::array<double, 3> constraint{};
+};
+ThreeSteps at_three_steps(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worker) {
+  ThreeSteps t;
+  t.landed = true;
+  double scale = 1.0;
+  for (int k = 0; k < 3; ++k, scale *= 0.5) {
+    EvaluationOptions options;
+    options.samples_per_phase = 0;
+    options.timestep_scale = scale;
+    const Evaluation e = ev.evaluate_normalized(x, worker, options);
+    t.landed_at[static_cast<std::size_t>(k)] = e.summary.landed && !e.summary.unstable;
+    t.landed = t.landed && t.landed_at[static_cast<std::size_t>(k)];
+    t.touchdown[static_cast<std::size_t>(k)] = {e.summary.touchdown_feet_x, e.summary.touchdown_feet_y};
+    t.constraint[static_cast<std::size_t>(k)] = e.constraint;
+  }
+  return t;
+}
+
+double apart(const std::array<double, 2>& a, const std::array<double, 2>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1]);
+}
+
+}  // namespace
+
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
-                                    const std::vector<double>& sigmas, int samples, int threads) {
+                                    const std::vector<double>& sigmas, int samples, int threads,
+                                    bool convergence) {
+  if (convergence && task.walk.enabled)
+    throw std::logic_error("measure_robustness: convergence compares a jump's touch-downs; " + task.name + " is a walk");
   const TaskEvaluator ev(task);
   const TaskEvaluator fine(halved(task, ev.model().get()));
   ThreadPool pool(std::max(1, threads));
@@ -522,7 +558,34 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
     l.samples = samples;
     l.met = static_cast<int>(std::count(c.begin(), c.end(), 0.0));
     l.constraints = std::move(c);
+    if (convergence) {
+      std::vector<ThreeSteps> three(xs.size());
+      pool.parallel_for(xs.size(), [&](std::size_t k, int worker) {
+        three[k] = at_three_steps(ev, xs[k], *workers[static_cast<std::size_t>(worker)]);
+      });
+      TimestepConvergence& v = l.convergence;
+      for (const ThreeSteps& t : three) {  // in perturb()'s order: the sums do not depend on threads
+        if (!t.landed) continue;
+        const double half = apart(t.touchdown[0], t.touchdown[1]);
+        const double quarter = apart(t.touchdown[1], t.touchdown[2]);
+        ++v.compared;
+        v.half_mean += half;
+        v.quarter_mean += quarter;
+        v.half_max = std::max(v.half_max, half);
+        v.quarter_max = std::max(v.quarter_max, quarter);
+      }
+      if (v.compared > 0) {
+        v.half_mean /= v.compared;
+        v.quarter_mean /= v.compared;
+      }
+    }
     report.levels.push_back(l);
+  }
+  if (convergence) {
+    const ThreeSteps t = at_three_steps(ev, x, *workers[0]);
+    for (std::size_t k = 0; k < 3; ++k)
+      report.touchdown_x[k] = t.landed_at[k] ? t.touchdown[k][0] : std::numeric_limits<double>::quiet_NaN();
+    report.constraint_quarter = t.constraint[2];
   }
   return report;
 }

@@ -68,6 +68,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -173,6 +174,21 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
 // it halved, and, for each sigma, how many of `samples` perturbations (perturb() with
 // robustness_seed()) meet the task as the diversity optimizer judges it: C = 0 at the
 // task's timestep, and with the half-timestep check where the task asks for it.
+//
+// With `convergence` (a jump task; std::logic_error for a walk), each perturbation and the
+// motion itself are also simulated at the task's timestep, half and a quarter of it, and
+// the report says how far apart their first touch-downs are: a motion converged in the
+// timestep comes down ever nearer one spot as the step shrinks, while one whose spots part
+// as far between half and a quarter of the step as between the step and half of it rides
+// on dynamics that small differences steer (a chaotic push-off or landing), and no
+// timestep will make its neighbourhood hold.
+struct TimestepConvergence {
+  int compared = 0;          // rollouts that touched down at all three timesteps
+  double half_mean = 0;      // m, mean distance of the touch-downs at the step and half of it
+  double half_max = 0;       // m, the largest
+  double quarter_mean = 0;   // m, the same at half and a quarter of the step
+  double quarter_max = 0;
+};
 struct RobustnessReport {
   double constraint = 0;       // C at the task's timestep
   double constraint_fine = 0;  // C with the timestep halved
@@ -182,12 +198,18 @@ struct RobustnessReport {
     int samples = 0;
     int met = 0;       // perturbations with C = 0
     std::vector<double> constraints;  // C of each perturbation, in perturb()'s order
+    TimestepConvergence convergence;  // with `convergence`: over the perturbations
     double fraction() const { return samples > 0 ? static_cast<double>(met) / samples : 0; }
   };
   std::vector<Level> levels;
+  // With `convergence`: the motion's first touch-down (x, m) at the step, half and a
+  // quarter of it (NaN where it did not touch down), and its C at a quarter of the step.
+  std::array<double, 3> touchdown_x{};
+  double constraint_quarter = 0;
 };
 RobustnessReport measure_robustness(const Task& task, const ParameterSet& parameters,
-                                    const std::vector<double>& sigmas, int samples, int threads);
+                                    const std::vector<double>& sigmas, int samples, int threads,
+                                    bool convergence = false);
 
 // What one rollout with constraint penalty c adds to a candidate's objective (see above):
 // c itself (kMeanC), or 0 when it meets the task and 1 + log(1 + c) / 100 when it misses

@@ -98,6 +98,42 @@ TEST(Robustness, ASigmasPerturbationsDoNotDependOnTheOtherSigmas) {
   EXPECT_NE(robustness_seed(task, 0.03), robustness_seed(task, 0.02));
 }
 
+// Convergence in the timestep: the high jump's input motion and its neighbours come down
+// within a centimetre of one spot at the task's step, half and a quarter of it, and nearer
+// as the step shrinks; jump_over's part as far between half and a quarter of the step as
+// between the step and half of it (a neighbourhood riding on chaotic dynamics), and its
+// input motion lands 17 cm further at a quarter of the step, where it falls. Thread counts
+// do not change the figures, and a walk has no touch-down to compare.
+TEST(Robustness, ConvergenceInTheTimestepTellsAChaoticNeighbourhood) {
+  const Task high = load_task(kTasks + "jump_high.toml");
+  const RobustnessReport h = measure_robustness(high, TaskEvaluator(high).load_parameters(high.m0), {0.005}, 8, 2, true);
+  const TimestepConvergence& hc = h.levels[0].convergence;
+  EXPECT_EQ(hc.compared, 8);
+  EXPECT_LT(hc.half_mean, 0.01);
+  EXPECT_LT(hc.quarter_mean, 0.01);
+  EXPECT_LE(hc.half_mean, hc.half_max);
+  EXPECT_NEAR(h.touchdown_x[1], h.touchdown_x[2], 0.01);
+  EXPECT_EQ(h.constraint_quarter, 0.0);
+
+  const Task over = load_task(kTasks + "jump_over.toml");
+  const ParameterSet m0 = TaskEvaluator(over).load_parameters(over.m0);
+  const RobustnessReport o = measure_robustness(over, m0, {0.005}, 8, 2, true);
+  const TimestepConvergence& oc = o.levels[0].convergence;
+  EXPECT_EQ(oc.compared, 8);
+  EXPECT_GT(oc.quarter_mean, 0.03);
+  EXPECT_GT(oc.quarter_mean, 0.5 * oc.half_mean);
+  EXPECT_GT(std::fabs(o.touchdown_x[2] - o.touchdown_x[1]), 0.1);
+  EXPECT_GE(o.constraint_quarter, over.constraints.fall_penalty);
+  // The same figures on one thread.
+  const RobustnessReport one = measure_robustness(over, m0, {0.005}, 8, 1, true);
+  EXPECT_EQ(one.levels[0].convergence.quarter_mean, oc.quarter_mean);
+  EXPECT_EQ(one.levels[0].convergence.half_max, oc.half_max);
+
+  const Task walk = load_task(kTasks + "robot_silly_walk.toml");
+  EXPECT_THROW(measure_robustness(walk, TaskEvaluator(walk).load_parameters(walk.m0), {0.005}, 1, 1, true),
+               std::logic_error);
+}
+
 // A perturbation meets the task as the diversity optimizer judges it: where the task has
 // the half-timestep check, one that meets it at 2 ms but lands elsewhere (or falls) at 1 ms
 // does not count. The high jump's input motion with the paper's foot targets lands 2.0 cm apart at the two timesteps
