@@ -548,6 +548,50 @@ void Jump3dController::point_legs(const mjData* d, const std::array<std::array<d
   }
 }
 
+void Jump3dController::place_lifted_legs(const mjData* d, const ContactState& contacts) {
+  // A leg off the ground while landing is placed again instead of holding its hip
+  // angles of the touch-down, which the body's turn toward its landing pitch would
+  // swing away: beside the foot still on the ground, moved along the heading toward
+  // the COM's capture point by at most kSwingReach; with both feet off, at the
+  // capture point (each foot at its standing sideways offset).
+  const double height = std::max(com_[2] - config_.landing_height_m, 0.1);
+  const double t_capture = std::sqrt(height / gravity_);
+  const double f[2] = {std::cos(heading_), std::sin(heading_)};
+  const double lat[2] = {-f[1], f[0]};
+  double capture[2];
+  for (int i = 0; i < 2; ++i) capture[i] = com_[static_cast<size_t>(i)] + t_capture * com_vel_[static_cast<size_t>(i)];
+  const int standing = contacts.foot[0] ? 0 : contacts.foot[1] ? 1 : -1;
+  std::array<std::array<double, 2>, 2> goals{};
+  for (int side = 0; side < 2; ++side) {
+    const double w = legs_[static_cast<size_t>(side)].lateral;
+    for (int i = 0; i < 2; ++i) goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = capture[i] + w * lat[i];
+    if (standing < 0) continue;
+    const int foot = body_.feet[static_cast<size_t>(standing)];
+    const double* joint = d->xpos + 3 * foot;   // the stance foot's joint
+    const double* centre = d->xipos + 3 * foot;  // and its sole's middle
+    const double reach = std::clamp(f[0] * (capture[0] - centre[0]) + f[1] * (capture[1] - centre[1]),
+                                    -kSwingReach, kSwingReach);
+    const double dw = w - legs_[static_cast<size_t>(standing)].lateral;
+    for (int i = 0; i < 2; ++i)
+      goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = joint[i] + reach * f[i] + dw * lat[i];
+  }
+  point_legs(d, goals, {!contacts.foot[0], !contacts.foot[1]}, target_);
+}
+
+void Jump3dController::turn_head_toward_landing(const mjData* d) {
+  const int root = body_.root_body;
+  // The head as a reaction mass: the root's backward pitch beyond the landing's target
+  // (and its rate) swings the head back, which turns the body forward, and the other way.
+  const double error = stance_->measured_pitches(d).root - pose_[kLand][static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])][0];
+  const double* w = d->cvel + 6 * root;
+  const double rate = -(-std::sin(heading_) * w[0] + std::cos(heading_) * w[1]);  // backwards
+  const double turn = config_.neck_attitude_kp * error + config_.neck_attitude_kd * rate;
+  for (int k : body_.groups[static_cast<size_t>(neck_)].joints) {
+    const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+    target_[static_cast<size_t>(k)] = clamp_to_range(j, qpos0_[static_cast<size_t>(k)] + turn);
+  }
+}
+
 void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) {
   const double t = d->time;
   const int root = body_.root_body;
@@ -594,35 +638,8 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
 
   if (is_stance(phase_)) {
     for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
-    if (phase_ == kLand && config_.land_swing_placement && !(contacts.foot[0] && contacts.foot[1])) {
-      // A leg off the ground while landing is placed again instead of holding its hip
-      // angles of the touch-down, which the body's turn toward its landing pitch would
-      // swing away: beside the foot still on the ground, moved along the heading toward
-      // the COM's capture point by at most kSwingReach; with both feet off, at the
-      // capture point (each foot at its standing sideways offset).
-      const double height = std::max(com_[2] - config_.landing_height_m, 0.1);
-      const double t_capture = std::sqrt(height / gravity_);
-      const double f[2] = {std::cos(heading_), std::sin(heading_)};
-      const double lat[2] = {-f[1], f[0]};
-      double capture[2];
-      for (int i = 0; i < 2; ++i) capture[i] = com_[static_cast<size_t>(i)] + t_capture * com_vel_[static_cast<size_t>(i)];
-      const int standing = contacts.foot[0] ? 0 : contacts.foot[1] ? 1 : -1;
-      std::array<std::array<double, 2>, 2> goals{};
-      for (int side = 0; side < 2; ++side) {
-        const double w = legs_[static_cast<size_t>(side)].lateral;
-        for (int i = 0; i < 2; ++i) goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = capture[i] + w * lat[i];
-        if (standing < 0) continue;
-        const int foot = body_.feet[static_cast<size_t>(standing)];
-        const double* joint = d->xpos + 3 * foot;   // the stance foot's joint
-        const double* centre = d->xipos + 3 * foot;  // and its sole's middle
-        const double reach = std::clamp(f[0] * (capture[0] - centre[0]) + f[1] * (capture[1] - centre[1]),
-                                        -kSwingReach, kSwingReach);
-        const double dw = w - legs_[static_cast<size_t>(standing)].lateral;
-        for (int i = 0; i < 2; ++i)
-          goals[static_cast<size_t>(side)][static_cast<size_t>(i)] = joint[i] + reach * f[i] + dw * lat[i];
-      }
-      point_legs(d, goals, {!contacts.foot[0], !contacts.foot[1]}, target_);
-    }
+    if (phase_ == kLand && config_.land_swing_placement && !(contacts.foot[0] && contacts.foot[1]))
+      place_lifted_legs(d, contacts);
     stance_->set_pitches(from_.root + s * (goal_.root - from_.root), from_.torso + s * (goal_.torso - from_.torso),
                          {from_.foot[0] + s * (goal_.foot[0] - from_.foot[0]),
                           from_.foot[1] + s * (goal_.foot[1] - from_.foot[1])});
@@ -665,18 +682,7 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
       }
     }
   }
-  if (neck_ >= 0 && (config_.neck_attitude_kp > 0 || config_.neck_attitude_kd > 0)) {
-    // The head as a reaction mass: the root's backward pitch beyond the landing's target
-    // (and its rate) swings the head back, which turns the body forward, and the other way.
-    const double error = stance_->measured_pitches(d).root - pose_[kLand][static_cast<size_t>(pose_slot_[static_cast<size_t>(hip_)])][0];
-    const double* w = d->cvel + 6 * root;
-    const double rate = -(-std::sin(heading_) * w[0] + std::cos(heading_) * w[1]);  // backwards
-    const double turn = config_.neck_attitude_kp * error + config_.neck_attitude_kd * rate;
-    for (int k : body_.groups[static_cast<size_t>(neck_)].joints) {
-      const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
-      target_[static_cast<size_t>(k)] = clamp_to_range(j, qpos0_[static_cast<size_t>(k)] + turn);
-    }
-  }
+  if (neck_ >= 0 && (config_.neck_attitude_kp > 0 || config_.neck_attitude_kd > 0)) turn_head_toward_landing(d);
   const auto& kp = kp_[static_cast<size_t>(phase_)];
   const auto& kd = kd_[static_cast<size_t>(phase_)];
   for (size_t k = 0; k < n; ++k) {

@@ -203,6 +203,10 @@ class Jump3dController : public Controller {
   // on the ground), with the joints between hip and foot at their targets.
   void point_legs(const mjData* d, const std::array<std::array<double, 2>, 2>& goals,
                   const std::array<bool, 2>& which, std::vector<double>& targets) const;
+  // land_swing_placement: points every leg whose foot is off the ground (target_'s hips).
+  void place_lifted_legs(const mjData* d, const ContactState& contacts);
+  // neck_attitude_kp, kd: the sagittal neck's flight target from the root's pitch (target_).
+  void turn_head_toward_landing(const mjData* d);
 
   const Character& body_;
   Jump3dControllerConfig config_;
