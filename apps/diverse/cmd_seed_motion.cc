@@ -154,6 +154,9 @@ void check(const SeedArgs& args) {
       std::printf("    touch-downs at the step and half of it %.3f m apart on average (at most %.3f), at half and "
                   "a quarter %.3f m (at most %.3f); %d of %d compared\n",
                   v.half_mean, v.half_max, v.quarter_mean, v.quarter_max, v.compared, l.samples);
+      std::printf("    peak heights (set at take-off) %.4f m apart on average at the step and half of it, %.4f m at "
+                  "half and a quarter\n",
+                  v.peak_half_mean, v.peak_quarter_mean);
     }
   }
   if (args.robust) robust_check(ev, p, args.threads);

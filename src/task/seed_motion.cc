@@ -498,6 +498,7 @@ struct ThreeSteps {
   std::array<bool, 3> landed_at{};
   std::array<std::array<double, 2>, 3> touchdown{};
   std::array<double, 3> constraint{};
+  std::array<double, 3> peak{};  // m, peak COM height
 };
 ThreeSteps at_three_steps(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worker) {
   ThreeSteps t;
@@ -512,6 +513,7 @@ ThreeSteps at_three_steps(const TaskEvaluator& ev, const Eigen::VectorXd& x, Sim
     t.landed = t.landed && t.landed_at[static_cast<std::size_t>(k)];
     t.touchdown[static_cast<std::size_t>(k)] = {e.summary.touchdown_feet_x, e.summary.touchdown_feet_y};
     t.constraint[static_cast<std::size_t>(k)] = e.constraint;
+    t.peak[static_cast<std::size_t>(k)] = e.summary.peak_com_z;
   }
   return t;
 }
@@ -571,12 +573,16 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
         ++v.compared;
         v.half_mean += half;
         v.quarter_mean += quarter;
+        v.peak_half_mean += std::fabs(t.peak[0] - t.peak[1]);
+        v.peak_quarter_mean += std::fabs(t.peak[1] - t.peak[2]);
         v.half_max = std::max(v.half_max, half);
         v.quarter_max = std::max(v.quarter_max, quarter);
       }
       if (v.compared > 0) {
         v.half_mean /= v.compared;
         v.quarter_mean /= v.compared;
+        v.peak_half_mean /= v.compared;
+        v.peak_quarter_mean /= v.compared;
       }
     }
     report.levels.push_back(l);

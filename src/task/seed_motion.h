@@ -182,12 +182,16 @@ std::vector<Eigen::VectorXd> perturb(const Eigen::VectorXd& x, double sigma, int
 // as far between half and a quarter of the step as between the step and half of it rides
 // on dynamics that small differences steer (a chaotic push-off or landing), and no
 // timestep will make its neighbourhood hold.
+// Where the parting starts: the same rollouts' peak COM heights (set at take-off) are
+// compared too.
 struct TimestepConvergence {
   int compared = 0;          // rollouts that touched down at all three timesteps
   double half_mean = 0;      // m, mean distance of the touch-downs at the step and half of it
   double half_max = 0;       // m, the largest
   double quarter_mean = 0;   // m, the same at half and a quarter of the step
   double quarter_max = 0;
+  double peak_half_mean = 0;     // m, mean difference of the peak COM heights, step and half
+  double peak_quarter_mean = 0;  // m, the same, half and a quarter
 };
 struct RobustnessReport {
   double constraint = 0;       // C at the task's timestep
