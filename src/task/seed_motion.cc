@@ -491,18 +491,17 @@ std::uint64_t robustness_seed(const Task& task, double sigma) {
 
 namespace {
 
-// The first touch-downs of x at the task's timestep, half and a quarter of it (m, x and y),
-// and whether all three touched down.
+// x at the task's timestep, half and a quarter of it: whether it touched down, where
+// (m, x and y), its C and its peak COM height.
 struct ThreeSteps {
-  bool landed = false;                       // at all three
   std::array<bool, 3> landed_at{};
   std::array<std::array<double, 2>, 3> touchdown{};
   std::array<double, 3> constraint{};
-  std::array<double, 3> peak{};  // m, peak COM height
+  std::array<double, 3> peak{};  // m
+  bool landed() const { return landed_at[0] && landed_at[1] && landed_at[2]; }
 };
 ThreeSteps at_three_steps(const TaskEvaluator& ev, const Eigen::VectorXd& x, SimWorker& worker) {
   ThreeSteps t;
-  t.landed = true;
   double scale = 1.0;
   for (int k = 0; k < 3; ++k, scale *= 0.5) {
     EvaluationOptions options;
@@ -510,7 +509,6 @@ ThreeSteps at_three_steps(const TaskEvaluator& ev, const Eigen::VectorXd& x, Sim
     options.timestep_scale = scale;
     const Evaluation e = ev.evaluate_normalized(x, worker, options);
     t.landed_at[static_cast<std::size_t>(k)] = e.summary.landed && !e.summary.unstable;
-    t.landed = t.landed && t.landed_at[static_cast<std::size_t>(k)];
     t.touchdown[static_cast<std::size_t>(k)] = {e.summary.touchdown_feet_x, e.summary.touchdown_feet_y};
     t.constraint[static_cast<std::size_t>(k)] = e.constraint;
     t.peak[static_cast<std::size_t>(k)] = e.summary.peak_com_z;
@@ -567,7 +565,7 @@ RobustnessReport measure_robustness(const Task& task, const ParameterSet& parame
       });
       TimestepConvergence& v = l.convergence;
       for (const ThreeSteps& t : three) {  // in perturb()'s order: the sums do not depend on threads
-        if (!t.landed) continue;
+        if (!t.landed()) continue;
         const double half = apart(t.touchdown[0], t.touchdown[1]);
         const double quarter = apart(t.touchdown[1], t.touchdown[2]);
         ++v.compared;
