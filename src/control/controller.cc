@@ -53,11 +53,11 @@ std::vector<std::string> controller_names() {
   return names;
 }
 
-JointDrive make_drive(const Character& body, SaturatedDrive saturated) {
+JointDrive make_drive(const Character& body, SaturatedDrive saturated, Damping damping) {
   std::vector<DrivenJoint> joints;
   joints.reserve(body.joints.size());
   for (const CharacterJoint& j : body.joints) joints.push_back({j.actuator, j.dof, j.torque_limit});
-  return JointDrive(std::move(joints), saturated);
+  return JointDrive(std::move(joints), saturated, damping);
 }
 
 }  // namespace diverse

@@ -122,6 +122,7 @@ const ControllerType& find_controller(const std::string& name, const std::string
 std::vector<std::string> controller_names();
 
 // The joint drive of a character: one driven joint per Character::joints entry, in order.
-JointDrive make_drive(const Character& body, SaturatedDrive saturated = SaturatedDrive::kExplicit);
+JointDrive make_drive(const Character& body, SaturatedDrive saturated = SaturatedDrive::kExplicit,
+                      Damping damping = Damping::kMujoco);
 
 }  // namespace diverse

@@ -552,6 +552,18 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
     // The strength model scales every joint's PD gains (Character::strength).
     const double kp = body_.strength * (gs >= 0 ? kp_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kp);
     const double kd = body_.strength * (gs >= 0 ? kd_[static_cast<size_t>(phase_)][static_cast<size_t>(gs)] : group.kd);
+    if (stance && tracked_[i] != Tracked::kNone && drive.damping() == Damping::kConstrained) {
+      // The drive damps the tracked link's world pitch rate itself: root pitch rate plus
+      // the joint rates down the chain to the child; the parent's is that less qdot.
+      damped_.clear();
+      const double sign = tracked_[i] == Tracked::kParent ? -1.0 : 1.0;
+      damped_.push_back({body_.root_pitch_dof, sign});
+      for (int k : body_.chain(static_cast<int>(i)))
+        damped_.push_back({body_.joints[static_cast<size_t>(k)].dof, sign});
+      if (tracked_[i] == Tracked::kParent) damped_.push_back({j.dof, 1.0});
+      drive.set(static_cast<int>(i), kp * (target_[i] - q[j.qpos]) + balance_[i], kd, damped_);
+      continue;
+    }
     double world_damping = 0;
     if (stance && tracked_[i] != Tracked::kNone) {
       const double child_rate = body_.child_pitch_rate(v, static_cast<int>(i));

@@ -190,6 +190,7 @@ class JumpController : public Controller {
   std::vector<int> pose_slot_;     // per group: index into posed_, or -1 (holds 0)
   std::vector<int> gain_slot_;     // per group: 0 hip, 1 knee, 2 ankle, -1 default gains
   std::vector<Tracked> tracked_;   // per joint, in stance phases
+  std::vector<DampedDof> damped_;  // scratch: a tracked joint's damped velocity
   std::vector<int> side_;          // per joint: 0 left or centre, 1 right
   double thigh_length_ = 0, shin_length_ = 0;  // m, hip-knee and knee-ankle at qpos0
   // Parameters unpacked.

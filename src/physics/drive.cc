@@ -33,11 +33,15 @@ std::vector<DrivenJoint> driven_joints(const mjModel* m) {
   return joints;
 }
 
-JointDrive::JointDrive(std::vector<DrivenJoint> joints, SaturatedDrive saturated)
+JointDrive::JointDrive(std::vector<DrivenJoint> joints, SaturatedDrive saturated, Damping damping)
     : joints_(std::move(joints)),
       saturated_(saturated),
+      damping_(damping),
       u_(joints_.size(), 0.0),
       kd_(joints_.size(), 0.0),
+      damped_(joints_.size()),
+      torque_(joints_.size(), 0.0),
+      held_(joints_.size(), 0),
       qdot_(joints_.size(), 0.0),
       explicit_(joints_.size(), 0) {
   for (const DrivenJoint& j : joints_) dofs_.push_back(j.dof);
@@ -47,6 +51,8 @@ bool JointDrive::apply(mjModel* m, mjData* d) {
   ++counts_.steps;
   redone_ = false;
   bool damping_changed = false;
+  const bool constrained = damping_ == Damping::kConstrained;
+  if (constrained) solve_constrained(m, d);
   for (size_t k = 0; k < joints_.size(); ++k) {
     const DrivenJoint& j = joints_[k];
     const double u = u_[k], kd = kd_[k], qdot = d->qvel[j.dof];
@@ -55,9 +61,9 @@ bool JointDrive::apply(mjModel* m, mjData* d) {
     // Implicit only while neither the motor (ctrl = u) nor the request is saturated: a
     // saturated request is exactly what the explicit way delivers, and implicit damping
     // on top of a clamped motor is what broke the limit before.
-    const bool implicit = std::fabs(u) <= j.limit && std::fabs(request) <= j.limit;
+    const bool implicit = !constrained && std::fabs(u) <= j.limit && std::fabs(request) <= j.limit;
     explicit_[k] = implicit ? 0 : 1;
-    d->ctrl[j.actuator] = implicit ? u : explicit_torque(m, d, k, qdot);
+    d->ctrl[j.actuator] = implicit ? u : constrained ? torque_[k] : explicit_torque(m, d, k, qdot);
     const double damping = implicit ? kd : 0.0;
     if (m->dof_damping[j.dof] != damping) {
       m->dof_damping[j.dof] = damping;
@@ -87,10 +93,110 @@ double JointDrive::explicit_torque(const mjModel* m, mjData* d, size_t k, double
   return std::clamp(request, -j.limit, j.limit);
 }
 
+void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
+  const int n = size(), nv = m->nv, nefc = d->nefc;
+  // The inertia with the step's constraint rows held, soft as MuJoCo makes them (R):
+  // H = M + J^T R^-1 J, whose inverse is M^-1 - M^-1 J^T (J M^-1 J^T + R)^-1 J M^-1
+  // (Woodbury), the response to a torque while the constraints hold.
+  inertia_.resize(nv, nv);
+  mj_fullM(m, inertia_.data(), d->qM);
+  if (nefc > 0) {
+    jacobian_.resize(nefc, nv);
+    if (mj_isSparse(m)) {
+      Eigen::VectorXd row = Eigen::VectorXd::Zero(nefc), jt(nv);
+      for (int i = 0; i < nefc; ++i) {
+        row[i] = 1;
+        mj_mulJacTVec(m, d, jt.data(), row.data());
+        jacobian_.row(i) = jt.transpose();
+        row[i] = 0;
+      }
+    } else {
+      jacobian_ = Eigen::Map<const RowMajor>(d->efc_J, nefc, nv);
+    }
+    compliance_ = Eigen::Map<const Eigen::VectorXd>(d->efc_R, nefc).cwiseInverse();
+    inertia_.noalias() += jacobian_.transpose() * compliance_.asDiagonal() * jacobian_;
+  }
+  inertia_llt_.compute(inertia_);
+  // response = H^-1 S^T: every dof's acceleration per unit torque at each driven joint.
+  response_cols_.setZero(nv, n);
+  for (int k = 0; k < n; ++k) response_cols_(joints_[static_cast<size_t>(k)].dof, k) = 1;
+  inertia_llt_.solveInPlace(response_cols_);
+  // The dampers' velocities now and their response: B = C H^-1 S^T.
+  damped_response_.resize(n, n);
+  damped_velocity_.resize(n);
+  for (int k = 0; k < n; ++k) {
+    const std::vector<DampedDof>& c = damped_[static_cast<size_t>(k)];
+    if (c.empty()) {
+      const int dof = joints_[static_cast<size_t>(k)].dof;
+      damped_response_.row(k) = response_cols_.row(dof);
+      damped_velocity_[k] = d->qvel[dof];
+    } else {
+      damped_response_.row(k).setZero();
+      damped_velocity_[k] = 0;
+      for (const DampedDof& t : c) {
+        damped_response_.row(k) += t.weight * response_cols_.row(t.dof);
+        damped_velocity_[k] += t.weight * d->qvel[t.dof];
+      }
+    }
+  }
+  // tau = u - Kd (c qdot + h B tau): (I + h Kd B) tau = u - Kd c qdot. A joint whose
+  // torque would pass its limit is held there, the one furthest beyond first, and the
+  // rest solved again; the inverse of the free joints' system is updated as each is held
+  // (Schur complement), so each round costs O(n^2).
+  const double h = m->opt.timestep;
+  system_.setIdentity(n, n);
+  for (int a = 0; a < n; ++a) system_.row(a) += h * kd_[static_cast<size_t>(a)] * damped_response_.row(a);
+  inverse_ = system_.partialPivLu().inverse();
+  free_.resize(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) free_[static_cast<size_t>(k)] = k;
+  std::fill(held_.begin(), held_.end(), 0);
+  rhs_.resize(n);
+  for (int k = 0; k < n; ++k)
+    rhs_[k] = u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * damped_velocity_[k];
+  for (int round = 0; round < n; ++round) {
+    int worst = -1;
+    double worst_ratio = 1;
+    for (int a : free_) {
+      double t = 0;
+      for (int b : free_) t += inverse_(a, b) * rhs_[b];
+      const size_t ka = static_cast<size_t>(a);
+      // Non-finite only from a non-finite state; the rollout's own checks report it.
+      torque_[ka] = std::isfinite(t) ? t : 0.0;
+      const double ratio = std::fabs(torque_[ka]) / joints_[ka].limit;
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst = a;
+      }
+    }
+    if (worst < 0) break;
+    const size_t kw = static_cast<size_t>(worst);
+    torque_[kw] = std::clamp(torque_[kw], -joints_[kw].limit, joints_[kw].limit);
+    held_[kw] = 1;
+    free_.erase(std::find(free_.begin(), free_.end(), worst));
+    // The held torque moves to the right-hand side of the others' equations ...
+    for (int a : free_) rhs_[a] -= system_(a, worst) * torque_[kw];
+    // ... and the free joints' inverse loses the held one (Schur complement), or is
+    // computed afresh should its pivot vanish.
+    const double pivot = inverse_(worst, worst);
+    if (std::isfinite(pivot) && pivot != 0) {
+      for (int a : free_)
+        for (int b : free_) inverse_(a, b) -= inverse_(a, worst) * inverse_(worst, b) / pivot;
+    } else if (!free_.empty()) {
+      const auto f = static_cast<Eigen::Index>(free_.size());
+      Eigen::MatrixXd reduced(f, f);
+      for (Eigen::Index a = 0; a < f; ++a)
+        for (Eigen::Index b = 0; b < f; ++b) reduced(a, b) = system_(free_[static_cast<size_t>(a)], free_[static_cast<size_t>(b)]);
+      const Eigen::MatrixXd inv = reduced.partialPivLu().inverse();
+      for (Eigen::Index a = 0; a < f; ++a)
+        for (Eigen::Index b = 0; b < f; ++b) inverse_(free_[static_cast<size_t>(a)], free_[static_cast<size_t>(b)]) = inv(a, b);
+    }
+  }
+}
+
 void JointDrive::make_explicit(mjModel* m, mjData* d, size_t k) {
   const DrivenJoint& j = joints_[k];
   explicit_[k] = 1;
-  d->ctrl[j.actuator] = explicit_torque(m, d, k, qdot_[k]);
+  d->ctrl[j.actuator] = damping_ == Damping::kConstrained ? torque_[k] : explicit_torque(m, d, k, qdot_[k]);
   m->dof_damping[j.dof] = 0;
 }
 

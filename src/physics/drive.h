@@ -38,6 +38,29 @@
 // The net torque is still ctrl, within the limit. SaturatedDrive::kExplicit (the default)
 // is the plain clamp above, with which every input motion of the first release was found.
 //
+// Damping::kConstrained drives every joint this way, but with the inertia the joints have
+// while this step's contacts and limits hold: the controller's requests are solved
+// together, each damper on the velocity the drive predicts for the step's end,
+//
+//     tau = u - Kd (c qdot_t + h B tau),   B = C M_c^-1 S^T,
+//     M_c^-1 = M^-1 - M^-1 J^T (J M^-1 J^T + R)^-1 J M^-1
+//
+// (S selects the driven joints, C the velocities the dampers act on: a joint's own, or a
+// link's world pitch rate for a controller that damps that; J and R the step's
+// constraint rows and their regularization, from mj_step1). A joint whose torque would
+// pass its limit is held at the limit and the rest solved again, the furthest beyond its
+// limit first. Every joint is then applied explicitly, ctrl = tau, dof_damping 0: the net
+// torque is ctrl, within the limit, and a record replays as any other.
+//
+// Why: MuJoCo's implicit damping and the stable PD above divide a joint's damper by
+// 1 + h kd / I with I the joint's inertia with every other joint and the root free. In a
+// push-off the feet are held by the floor and the inertia a hip meets is the trunk's, not
+// the leg's; with the free inertia the damper is weakened by a factor that changes with
+// the step (at the backflip's push-off gains about 0.6 at 2 ms, 0.75 at 1 ms), and the
+// same motion jumps differently at each step. With the constrained inertia the factor is
+// near 1 where the contacts hold the joint and as before where nothing does, so a motion
+// converges as the step shrinks (docs/robustness.md, "A drive that converges").
+//
 // An implicit joint can still exceed its limit if qdot_{t+1} jumps (an impact within the
 // step). run_rollout() (physics/rollout.h) therefore integrates, checks every implicit
 // joint's net torque on qdot_{t+1}, and if one exceeds its limit restores the state from
@@ -50,6 +73,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Dense>
 #include <vector>
 
 namespace diverse {
@@ -70,11 +94,23 @@ std::vector<DrivenJoint> driven_joints(const mjModel* m);
 // end-of-step velocity (a task's `[simulation] saturated_drive`, "explicit" or "stable_pd").
 enum class SaturatedDrive { kExplicit, kStablePd };
 
+// How the dampers are integrated (above): by MuJoCo on each joint's own inertia, saturated
+// joints as SaturatedDrive says (kMujoco, the default), or all joints together on the
+// inertia with the step's contacts held (kConstrained; a task's `[simulation] damping`).
+enum class Damping { kMujoco, kConstrained };
+
+// A term of the velocity a damper acts on under Damping::kConstrained: weight * qvel[dof].
+struct DampedDof {
+  int dof = -1;
+  double weight = 0;
+};
+
 class JointDrive {
  public:
   JointDrive() = default;
   explicit JointDrive(std::vector<DrivenJoint> joints,
-                      SaturatedDrive saturated = SaturatedDrive::kExplicit);
+                      SaturatedDrive saturated = SaturatedDrive::kExplicit,
+                      Damping damping = Damping::kMujoco);
 
   int size() const { return static_cast<int>(joints_.size()); }
   const std::vector<DrivenJoint>& joints() const { return joints_; }
@@ -86,7 +122,17 @@ class JointDrive {
   void set(int k, double u, double kd) {
     u_[static_cast<size_t>(k)] = u;
     kd_[static_cast<size_t>(k)] = kd;
+    damped_[static_cast<size_t>(k)].clear();
   }
+  // The same with the damper on sum_i weight_i * qvel[dof_i] instead of the joint's own
+  // velocity (a link's world pitch rate, say), under Damping::kConstrained. Under kMujoco
+  // the controller adds such damping to u itself (it is then explicit).
+  void set(int k, double u, double kd, const std::vector<DampedDof>& velocity) {
+    u_[static_cast<size_t>(k)] = u;
+    kd_[static_cast<size_t>(k)] = kd;
+    damped_[static_cast<size_t>(k)] = velocity;
+  }
+  Damping damping() const { return damping_; }
   double u(int k) const { return u_[static_cast<size_t>(k)]; }
   double kd(int k) const { return kd_[static_cast<size_t>(k)]; }
   // How the last step applied joint k's damping: in the motor (dof_damping 0) or not.
@@ -119,14 +165,28 @@ class JointDrive {
  private:
   void make_explicit(mjModel* m, mjData* d, size_t k);
 
+  // Damping::kConstrained: every joint's torque of this step into torque_.
+  void solve_constrained(const mjModel* m, mjData* d);
   // The explicit torque of joint k from its request, qdot and (for kStablePd) the state.
   double explicit_torque(const mjModel* m, mjData* d, size_t k, double qdot);
 
   std::vector<DrivenJoint> joints_;
   SaturatedDrive saturated_ = SaturatedDrive::kExplicit;
+  Damping damping_ = Damping::kMujoco;
   std::vector<int> dofs_;
   std::vector<mjtNum> unit_, response_;  // kStablePd scratch: e_k and M^-1 e_k
   std::vector<double> u_, kd_;
+  std::vector<std::vector<DampedDof>> damped_;  // per joint: its damped velocity; empty = its own
+  // Damping::kConstrained: this step's torques, and scratch kept between steps so that a
+  // step allocates nothing once the sizes have been seen.
+  std::vector<double> torque_;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::MatrixXd inertia_, response_cols_, damped_response_, system_, inverse_;
+  RowMajor jacobian_;  // the step's constraint rows
+  Eigen::VectorXd compliance_, damped_velocity_, rhs_;
+  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  std::vector<char> held_;
+  std::vector<int> free_;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
   std::vector<char> explicit_;  // per joint: damping applied explicitly in the motor
   bool redone_ = false;         // the current step has been integrated again

@@ -469,7 +469,7 @@ Evaluation TaskEvaluator::evaluate_on(const std::vector<double>& values, const C
   // The scaled friction lasts for this rollout only (SimWorker::reset restores it too).
   const FrictionRestore restore_friction(worker, options.friction_scale != 1.0);
   const auto controller = task_.controller_type->make(body, *task_.controller_config, values);
-  JointDrive drive = make_drive(body, task_.simulation.saturated_drive);
+  JointDrive drive = make_drive(body, task_.simulation.saturated_drive, task_.simulation.damping);
   controller->start_state(m, worker.data());
   if (task_.walk.enabled) {
     e = evaluate_walk(*controller, drive, body, worker, options);

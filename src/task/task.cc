@@ -162,7 +162,7 @@ void read_simulation(const TomlReader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
           "fall_tilt", "clearance_range", "timestep", "balanced_rest",
           "rest_hold", "hop_is_fall", "topple_distance",
-          "topple_after", "saturated_drive"});
+          "topple_after", "saturated_drive", "damping"});
   TaskSimulation& s = task.simulation;
   s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
   s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
@@ -180,6 +180,18 @@ void read_simulation(const TomlReader& r, Task& task) {
       s.saturated_drive = SaturatedDrive::kStablePd;
     } else {
       r.fail("saturated_drive", "expected \"explicit\" or \"stable_pd\", got \"" + way + "\"");
+    }
+  }
+  if (r.has("damping")) {
+    const std::string way = r.string("damping");
+    if (way == "mujoco") {
+      s.damping = Damping::kMujoco;
+    } else if (way == "constrained") {
+      s.damping = Damping::kConstrained;
+      if (r.has("saturated_drive"))
+        r.fail("saturated_drive", "has no effect with damping = \"constrained\" (every joint is driven that way); remove it");
+    } else {
+      r.fail("damping", "expected \"mujoco\" or \"constrained\", got \"" + way + "\"");
     }
   }
   s.max_time = r.number("max_time", 0.5, 60, s.max_time);

@@ -121,6 +121,13 @@ struct TaskSimulation {
   // on the step's start velocity, which chatters at a jump's flight gains) or "stable_pd"
   // (the damper on the predicted end-of-step velocity).
   SaturatedDrive saturated_drive = SaturatedDrive::kExplicit;
+  // How the dampers are integrated (physics/drive.h): `damping = "mujoco"` (the default:
+  // MuJoCo's implicit joint damping on each joint's own inertia, a saturated joint as
+  // saturated_drive says) or "constrained" (every joint's PD torque solved together, each
+  // damper on the velocity it will have at the step's end with the step's contacts held;
+  // a motion then converges as the step shrinks: docs/robustness.md, "A drive that
+  // converges"). saturated_drive has no say under "constrained".
+  Damping damping = Damping::kMujoco;
 };
 
 struct TaskSeed {

@@ -213,6 +213,20 @@ TEST_F(TaskFileTest, SaturatedDrive) {
             ": simulation.saturated_drive: expected a string");
 }
 
+TEST_F(TaskFileTest, Damping) {
+  EXPECT_EQ(load_task(write(valid_text())).simulation.damping, Damping::kMujoco);
+  EXPECT_EQ(load_task(write(valid_text() + "[simulation]\ndamping = \"constrained\"\n")).simulation.damping,
+            Damping::kConstrained);
+  EXPECT_EQ(load_task(write(valid_text() + "[simulation]\ndamping = \"mujoco\"\nsaturated_drive = \"stable_pd\"\n"))
+                .simulation.saturated_drive,
+            SaturatedDrive::kStablePd);
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\ndamping = \"implicit\"\n"),
+            ": simulation.damping: expected \"mujoco\" or \"constrained\", got \"implicit\"");
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\ndamping = \"constrained\"\nsaturated_drive = \"stable_pd\"\n"),
+            ": simulation.saturated_drive: has no effect with damping = \"constrained\" (every joint is "
+            "driven that way); remove it");
+}
+
 TEST_F(TaskFileTest, ModelPathMissing) {
   const std::string e = error_of(replace(valid_text(), "human2d.xml", "nobody.xml"));
   EXPECT_EQ(e.rfind(": character: expected an existing file (relative to the task file), but ", 0), 0u) << e;
