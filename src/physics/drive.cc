@@ -97,24 +97,29 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   const int n = size(), nv = m->nv, nefc = d->nefc;
   // The inertia with the step's constraint rows held, soft as MuJoCo makes them (R):
   // H = M + J^T R^-1 J, whose inverse is M^-1 - M^-1 J^T (J M^-1 J^T + R)^-1 J M^-1
-  // (Woodbury), the response to a torque while the constraints hold.
+  // (Woodbury), the response to a torque while the constraints hold. J^T R^-1 J is summed
+  // over each row's non-zeros (a contact row moves a few of a character's dofs).
   inertia_.resize(nv, nv);
-  mj_fullM(m, inertia_.data(), d->qM);
+  mj_fullM(m, inertia_.data(), d->qM);  // symmetric: row- or column-major alike
   if (nefc > 0) {
-    jacobian_.resize(nefc, nv);
-    if (mj_isSparse(m)) {
-      Eigen::VectorXd row = Eigen::VectorXd::Zero(nefc), jt(nv);
-      for (int i = 0; i < nefc; ++i) {
-        row[i] = 1;
-        mj_mulJacTVec(m, d, jt.data(), row.data());
-        jacobian_.row(i) = jt.transpose();
-        row[i] = 0;
+    row_.resize(static_cast<size_t>(nv));
+    basis_.assign(static_cast<size_t>(nefc), 0.0);
+    for (int i = 0; i < nefc; ++i) {
+      const mjtNum* jrow = d->efc_J + static_cast<std::ptrdiff_t>(i) * nv;
+      if (mj_isSparse(m)) {
+        basis_[static_cast<size_t>(i)] = 1;
+        mj_mulJacTVec(m, d, row_.data(), basis_.data());
+        basis_[static_cast<size_t>(i)] = 0;
+        jrow = row_.data();
       }
-    } else {
-      jacobian_ = Eigen::Map<const RowMajor>(d->efc_J, nefc, nv);
+      nonzero_.clear();
+      for (int a = 0; a < nv; ++a)
+        if (jrow[a] != 0) nonzero_.push_back(a);
+      const double w = 1 / d->efc_R[i];
+      for (int a : nonzero_)
+        for (int b : nonzero_)
+          inertia_(a, b) += w * jrow[a] * jrow[b];
     }
-    compliance_ = Eigen::Map<const Eigen::VectorXd>(d->efc_R, nefc).cwiseInverse();
-    inertia_.noalias() += jacobian_.transpose() * compliance_.asDiagonal() * jacobian_;
   }
   inertia_llt_.compute(inertia_);
   // response = H^-1 S^T: every dof's acceleration per unit torque at each driven joint.

@@ -180,11 +180,11 @@ class JointDrive {
   // Damping::kConstrained: this step's torques, and scratch kept between steps so that a
   // step allocates nothing once the sizes have been seen.
   std::vector<double> torque_;
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<mjtNum> row_, basis_;  // a constraint row, e_i
+  std::vector<int> nonzero_;
   Eigen::MatrixXd inertia_, response_cols_, damped_response_, system_, inverse_;
-  RowMajor jacobian_;  // the step's constraint rows
-  Eigen::VectorXd compliance_, damped_velocity_, rhs_;
   Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  Eigen::VectorXd damped_velocity_, rhs_;
   std::vector<char> held_;
   std::vector<int> free_;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
