@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace diverse {
@@ -158,6 +159,13 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   rhs_.resize(n);
   for (int k = 0; k < n; ++k)
     rhs_[k] = u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * damped_velocity_[k];
+  // A negative or non-finite gain is no damper: that joint's torque is NaN, which the
+  // rollout reports as an instability (MuJoCo's bad-ctrl warning), as the way with
+  // MuJoCo's damping does through dof_damping.
+  for (int k = 0; k < n; ++k) {
+    const double kd = kd_[static_cast<size_t>(k)];
+    if (!(kd >= 0) || !std::isfinite(kd)) rhs_[k] = std::numeric_limits<double>::quiet_NaN();
+  }
   for (int round = 0; round < n; ++round) {
     int worst = -1;
     double worst_ratio = 1;
@@ -165,8 +173,9 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
       double t = 0;
       for (int b : free_) t += inverse_(a, b) * rhs_[b];
       const size_t ka = static_cast<size_t>(a);
-      // Non-finite only from a non-finite state; the rollout's own checks report it.
-      torque_[ka] = std::isfinite(t) ? t : 0.0;
+      // A non-finite request or state gives a non-finite torque, which the rollout reports
+      // as an instability (MuJoCo's bad-ctrl warning) rather than a quiet zero.
+      torque_[ka] = t;
       const double ratio = std::fabs(torque_[ka]) / joints_[ka].limit;
       if (ratio > worst_ratio) {
         worst_ratio = ratio;

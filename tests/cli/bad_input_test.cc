@@ -182,9 +182,9 @@ TEST(BadInput, TaskFileFields) {
       task_case(task_text("jump_onto", {{"name = \"box\"", "name = \"box\\\" pos=\\\"0 0 9\""},
                                         {"object = \"box\"", "object = \"box\\\" pos=\\\"0 0 9\""}}),
                 "objects[0].name: expected 1 to 64 letters, digits, '_', '-' or '.', got \"box\" pos=\"0 0 9\""),
-      task_case(task_text("jump_high", {}, "\n[simulation]\ntimestep = 1e-300\n"),
+      task_case(task_text("jump_high", {{"timestep = 0.004", "timestep = 1e-300"}}),
                 "simulation.timestep: expected 0 (the model's) or a number in [1e-05, 0.01], got 1e-300"),
-      task_case(task_text("jump_high", {}, "\n[simulation]\ntimestep = 0.5\n"),
+      task_case(task_text("jump_high", {{"timestep = 0.004", "timestep = 0.5"}}),
                 "simulation.timestep: expected a number in [0, 0.01], got 0.5"),
       // A box-top margin wider than half the box: nowhere to stand.
       task_case(task_text("jump_onto", {{"margin = 0.1", "margin = 0.45"}}),
@@ -254,7 +254,9 @@ fs::path character_variant(const fs::path& dir, const std::string& name,
   }
   write(cdir / "human2d.toml", toml);
   const fs::path task = cdir / "task.toml";
-  write(task, task_text("jump_high", {{kSource + "/assets/characters/human2d.toml", (cdir / "human2d.toml").string()}}));
+  // At the model's own timestep, so that the model's option.timestep is the one used.
+  write(task, task_text("jump_high", {{kSource + "/assets/characters/human2d.toml", (cdir / "human2d.toml").string()},
+                                      {"timestep = 0.004\n", ""}}));
   return task;
 }
 

@@ -245,7 +245,7 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
     for (int k = 0; k < 48; ++k) {
       Eigen::VectorXd x = m0.normalized();
       if (k > 0)
-        for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j] + 0.03 * rng.normal(), 0.0, 1.0);
+        for (Eigen::Index j = 0; j < x.size(); ++j) x[j] = std::clamp(x[j] + 0.05 * rng.normal(), 0.0, 1.0);
       const Evaluation a = ev.evaluate_normalized(x, *worker, full);
       const Evaluation b = ev.evaluate_normalized(x, *worker, ended);
       steps_full += a.stats.steps;

@@ -32,7 +32,9 @@ const std::string kHops = kSource + "/tests/task/data/jump_high_paper_feet.m0.js
 // paper's, as the earlier input motion was found with it.
 fs::path variant(const std::string& name, const std::string& controller, const std::string& simulation) {
   return test_files::task_variant("jump_high", "standing_start_" + name,
-                                  {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach ="},
+                                  // The earlier motions were found under MuJoCo's damping at 2 ms.
+                                  {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach =",
+                                   "damping =", "timestep ="},
                                   {{"controller", controller}, {"simulation", simulation}});
 }
 
