@@ -240,13 +240,48 @@ void expect_smooth_at_2ms_under_stable_pd(const std::string& name, const Smoothn
   EXPECT_GT(spread_of_nudged_m0(explicit_way, s.at_rest), s.chaotic);
 }
 
-// The backflip runs at 2 ms with stable PD for saturated joints. Its input motion found
-// with the explicit way (tests/task/data/backflip_explicit.toml) had to run at 1 ms: at
-// 2 ms its hips chattered between their limits in the air, and parameters 1e-5 apart came
-// to rest up to 11 cm apart (4 mm at 1 ms). The committed one at 2 ms: within 0.1 mm.
-TEST(M0Specifics, BackflipChangesSmoothlyAtItsTimestep) {
+// The backflip runs at 2 ms under constrained damping. Parameters 1e-5 apart come to rest
+// within 5 mm, and the input motion is the same flip at every step: it touches down
+// within 2 cm of one spot at 2, 1 and 0.5 ms (measured: 0.132, 0.121, 0.127 m). The input
+// motion it had before, found under stable PD on the free inertia
+// (tests/task/data/backflip_stable_pd.toml), touched down at 0.061, 0.070 and 0.114 m: its
+// push-off got a different torque at every step. Before that, the one found the explicit
+// way (tests/task/data/backflip_explicit.toml) had to run at 1 ms: at 2 ms its hips
+// chattered between their limits in the air and parameters 1e-5 apart came to rest up to
+// 11 cm apart (4 mm at 1 ms).
+double touchdown_at(Task task, double timestep) {
+  task.simulation.timestep = timestep;
+  const TaskEvaluator ev(task);
+  auto worker = ev.make_worker();
+  EvaluationOptions options;
+  options.samples_per_phase = 0;
+  const Evaluation e = ev.evaluate(ev.load_parameters(task.m0).values(), *worker, options);
+  EXPECT_EQ(e.constraint, 0) << task.name << " at " << timestep << " s";
+  return e.summary.touchdown_feet_x;
+}
+TEST(M0Specifics, BackflipIsTheSameFlipAtEveryStep) {
   REQUIRE_M0("backflip");
-  expect_smooth_at_2ms_under_stable_pd("backflip", {true, 0.005, 0.01, 0.05});
+  const Task task = load_task(kTasks + "backflip.toml");
+  ASSERT_EQ(task.simulation.damping, Damping::kConstrained);
+  ASSERT_EQ(TaskEvaluator(task).model().get()->opt.timestep, 0.002);
+  EXPECT_LT(spread_of_nudged_m0(task, true), 0.005);
+  const double x2 = touchdown_at(task, 0.002), x1 = touchdown_at(task, 0.001), x05 = touchdown_at(task, 0.0005);
+  std::printf("backflip touches down at %.3f, %.3f, %.3f m at 2, 1, 0.5 ms\n", x2, x1, x05);
+  EXPECT_LT(std::max({x2, x1, x05}) - std::min({x2, x1, x05}), 0.02);
+
+  const Task before = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/backflip_stable_pd.toml");
+  ASSERT_EQ(before.simulation.damping, Damping::kMujoco);
+  ASSERT_EQ(before.simulation.saturated_drive, SaturatedDrive::kStablePd);
+  const double b1 = touchdown_at(before, 0.001), b05 = touchdown_at(before, 0.0005);
+  std::printf("under stable PD on the free inertia: %.3f, %.3f m at 1, 0.5 ms\n", b1, b05);
+  EXPECT_GT(std::fabs(b1 - b05), 0.03);
+
+  Task explicit_way = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/backflip_explicit.toml");
+  ASSERT_EQ(explicit_way.simulation.saturated_drive, SaturatedDrive::kExplicit);
+  ASSERT_EQ(explicit_way.simulation.timestep, 0.001);
+  EXPECT_LT(spread_of_nudged_m0(explicit_way, true), 0.01);
+  explicit_way.simulation.timestep = 0.002;
+  EXPECT_GT(spread_of_nudged_m0(explicit_way, true), 0.05);
 }
 
 // jump_over runs at the planar human's 2 ms with stable PD for saturated joints. Its input
