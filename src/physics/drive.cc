@@ -42,7 +42,6 @@ JointDrive::JointDrive(std::vector<DrivenJoint> joints, SaturatedDrive saturated
       kd_(joints_.size(), 0.0),
       damped_(joints_.size()),
       torque_(joints_.size(), 0.0),
-      held_(joints_.size(), 0),
       qdot_(joints_.size(), 0.0),
       explicit_(joints_.size(), 0) {
   for (const DrivenJoint& j : joints_) dofs_.push_back(j.dof);
@@ -155,7 +154,6 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   inverse_ = system_.partialPivLu().inverse();
   free_.resize(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) free_[static_cast<size_t>(k)] = k;
-  std::fill(held_.begin(), held_.end(), 0);
   rhs_.resize(n);
   for (int k = 0; k < n; ++k)
     rhs_[k] = u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * damped_velocity_[k];
@@ -185,7 +183,6 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
     if (worst < 0) break;
     const size_t kw = static_cast<size_t>(worst);
     torque_[kw] = std::clamp(torque_[kw], -joints_[kw].limit, joints_[kw].limit);
-    held_[kw] = 1;
     free_.erase(std::find(free_.begin(), free_.end(), worst));
     // The held torque moves to the right-hand side of the others' equations ...
     for (int a : free_) rhs_[a] -= system_(a, worst) * torque_[kw];

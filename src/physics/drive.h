@@ -185,7 +185,6 @@ class JointDrive {
   Eigen::MatrixXd inertia_, response_cols_, damped_response_, system_, inverse_;
   Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
   Eigen::VectorXd damped_velocity_, rhs_;
-  std::vector<char> held_;
   std::vector<int> free_;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
   std::vector<char> explicit_;  // per joint: damping applied explicitly in the motor
