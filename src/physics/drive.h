@@ -56,8 +56,8 @@
 // 1 + h kd / I with I the joint's inertia with every other joint and the root free. In a
 // push-off the feet are held by the floor and the inertia a hip meets is the trunk's, not
 // the leg's; with the free inertia the damper is weakened by a factor that changes with
-// the step (at the backflip's push-off gains about 0.6 at 2 ms, 0.75 at 1 ms), and the
-// same motion jumps differently at each step. With the constrained inertia the factor is
+// the step (the backflip's hips in its push-off: divided by 3.5 at 2 ms, 2.3 at 1 ms), and
+// the same motion jumps differently at each step. With the constrained inertia the factor is
 // near 1 where the contacts hold the joint and as before where nothing does, so a motion
 // converges as the step shrinks (docs/robustness.md, "A drive that converges").
 //
@@ -177,8 +177,7 @@ class JointDrive {
   std::vector<mjtNum> unit_, response_;  // kStablePd scratch: e_k and M^-1 e_k
   std::vector<double> u_, kd_;
   std::vector<std::vector<DampedDof>> damped_;  // per joint: its damped velocity; empty = its own
-  // Damping::kConstrained: this step's torques, and scratch kept between steps so that a
-  // step allocates nothing once the sizes have been seen.
+  // Damping::kConstrained: this step's torques, and scratch kept between steps.
   std::vector<double> torque_;
   std::vector<mjtNum> row_, basis_;  // a constraint row, e_i
   std::vector<int> nonzero_;
