@@ -151,7 +151,8 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   const double h = m->opt.timestep;
   system_.setIdentity(n, n);
   for (int a = 0; a < n; ++a) system_.row(a) += h * kd_[static_cast<size_t>(a)] * damped_response_.row(a);
-  inverse_ = system_.partialPivLu().inverse();
+  system_lu_.compute(system_);
+  inverse_ = system_lu_.inverse();
   free_.resize(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) free_[static_cast<size_t>(k)] = k;
   rhs_.resize(n);

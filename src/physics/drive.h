@@ -183,6 +183,7 @@ class JointDrive {
   std::vector<int> nonzero_;
   Eigen::MatrixXd inertia_, response_cols_, damped_response_, system_, inverse_;
   Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> system_lu_;
   Eigen::VectorXd damped_velocity_, rhs_;
   std::vector<int> free_;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
