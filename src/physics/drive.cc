@@ -121,88 +121,124 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
           inertia_(a, b) += w * jrow[a] * jrow[b];
     }
   }
-  inertia_llt_.compute(inertia_);
-  // response = H^-1 S^T: every dof's acceleration per unit torque at each driven joint.
-  response_cols_.setZero(nv, n);
-  for (int k = 0; k < n; ++k) response_cols_(joints_[static_cast<size_t>(k)].dof, k) = 1;
-  inertia_llt_.solveInPlace(response_cols_);
-  // The dampers' velocities now and their response: B = C H^-1 S^T.
-  damped_response_.resize(n, n);
-  damped_velocity_.resize(n);
+  // Each joint's damped velocity now (c_k qdot) and its request without the step's part,
+  // r_k = u_k - kd_k c_k qdot. A negative or non-finite gain is no damper: the torques are
+  // then NaN, which the rollout reports as an instability (MuJoCo's bad-ctrl warning), as
+  // the way with MuJoCo's damping does through dof_damping.
+  const double h = m->opt.timestep;
+  rhs_.resize(n);
+  bool symmetric = true;
   for (int k = 0; k < n; ++k) {
-    const std::vector<DampedDof>& c = damped_[static_cast<size_t>(k)];
+    const size_t kk = static_cast<size_t>(k);
+    const std::vector<DampedDof>& c = damped_[kk];
+    double velocity = d->qvel[joints_[kk].dof];
+    if (!c.empty()) {
+      symmetric = false;
+      velocity = 0;
+      for (const DampedDof& t : c) velocity += t.weight * d->qvel[t.dof];
+    }
+    const double kd = kd_[kk];
+    rhs_[k] = kd >= 0 && std::isfinite(kd) ? u_[kk] - kd * velocity
+                                           : std::numeric_limits<double>::quiet_NaN();
+  }
+  // tau = u - Kd (c qdot + h C x) with H x = S^T tau (x: the step's velocity change per
+  // unit of step). With every joint free, substituting tau gives one nv x nv solve,
+  //
+  //     A x = S^T r,   A = H + h S^T Kd C,   tau = r - h Kd C x,
+  //
+  // A symmetric positive definite when every damper is on its joint's own velocity. A
+  // joint whose torque would pass its limit is held there (the one furthest beyond first)
+  // and the rest solved again: holding joint w takes h kd_w s_w c_w^T out of A and puts
+  // s_w (tau_w - r_w) into the right-hand side, a rank-one change each, so with the set W
+  // held (Woodbury, P_w = A^-1 s_w, Z = A^-1 U, U = [h kd_w s_w], V = [c_w]):
+  //
+  //     y = x_0 + sum_w P_w (tau_w - r_w),   x_W = y + Z (I - V^T Z)^-1 V^T y,
+  //
+  // O(nv^2) a held joint after A's one factorization.
+  system_ = inertia_;
+  step_rhs_.setZero(nv);
+  for (int k = 0; k < n; ++k) {
+    const size_t kk = static_cast<size_t>(k);
+    const int dof = joints_[kk].dof;
+    step_rhs_[dof] += rhs_[k];
+    const double gain = h * kd_[kk];
+    const std::vector<DampedDof>& c = damped_[kk];
     if (c.empty()) {
-      const int dof = joints_[static_cast<size_t>(k)].dof;
-      damped_response_.row(k) = response_cols_.row(dof);
-      damped_velocity_[k] = d->qvel[dof];
+      system_(dof, dof) += gain;
     } else {
-      damped_response_.row(k).setZero();
-      damped_velocity_[k] = 0;
-      for (const DampedDof& t : c) {
-        damped_response_.row(k) += t.weight * response_cols_.row(t.dof);
-        damped_velocity_[k] += t.weight * d->qvel[t.dof];
-      }
+      for (const DampedDof& t : c) system_(dof, t.dof) += gain * t.weight;
     }
   }
-  // tau = u - Kd (c qdot + h B tau): (I + h Kd B) tau = u - Kd c qdot. A joint whose
-  // torque would pass its limit is held there, the one furthest beyond first, and the
-  // rest solved again; the inverse of the free joints' system is updated as each is held
-  // (Schur complement), so each round costs O(n^2).
-  const double h = m->opt.timestep;
-  system_.setIdentity(n, n);
-  for (int a = 0; a < n; ++a) system_.row(a) += h * kd_[static_cast<size_t>(a)] * damped_response_.row(a);
-  system_lu_.compute(system_);
-  inverse_ = system_lu_.inverse();
-  free_.resize(static_cast<size_t>(n));
-  for (int k = 0; k < n; ++k) free_[static_cast<size_t>(k)] = k;
-  rhs_.resize(n);
-  for (int k = 0; k < n; ++k)
-    rhs_[k] = u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * damped_velocity_[k];
-  // A negative or non-finite gain is no damper: that joint's torque is NaN, which the
-  // rollout reports as an instability (MuJoCo's bad-ctrl warning), as the way with
-  // MuJoCo's damping does through dof_damping.
-  for (int k = 0; k < n; ++k) {
-    const double kd = kd_[static_cast<size_t>(k)];
-    if (!(kd >= 0) || !std::isfinite(kd)) rhs_[k] = std::numeric_limits<double>::quiet_NaN();
+  if (symmetric) {
+    system_llt_.compute(system_);
+    free_change_ = system_llt_.solve(step_rhs_);
+  } else {
+    system_lu_.compute(system_);
+    free_change_ = system_lu_.solve(step_rhs_);
   }
-  for (int round = 0; round < n; ++round) {
+  change_ = free_change_;
+  held_.clear();
+  for (int round = 0; round <= n; ++round) {
     int worst = -1;
     double worst_ratio = 1;
-    for (int a : free_) {
-      double t = 0;
-      for (int b : free_) t += inverse_(a, b) * rhs_[b];
-      const size_t ka = static_cast<size_t>(a);
-      // A non-finite request or state gives a non-finite torque, which the rollout reports
-      // as an instability (MuJoCo's bad-ctrl warning) rather than a quiet zero.
-      torque_[ka] = t;
-      const double ratio = std::fabs(torque_[ka]) / joints_[ka].limit;
+    for (int k = 0; k < n; ++k) {
+      const size_t kk = static_cast<size_t>(k);
+      if (std::find(held_.begin(), held_.end(), k) != held_.end()) continue;
+      // A non-finite request or state gives a non-finite torque, which the rollout
+      // reports as an instability rather than a quiet zero.
+      torque_[kk] = rhs_[k] - h * kd_[kk] * damped_velocity(kk, change_);
+      const double ratio = std::fabs(torque_[kk]) / joints_[kk].limit;
       if (ratio > worst_ratio) {
         worst_ratio = ratio;
-        worst = a;
+        worst = k;
       }
     }
     if (worst < 0) break;
     const size_t kw = static_cast<size_t>(worst);
     torque_[kw] = std::clamp(torque_[kw], -joints_[kw].limit, joints_[kw].limit);
-    free_.erase(std::find(free_.begin(), free_.end(), worst));
-    // The held torque moves to the right-hand side of the others' equations ...
-    for (int a : free_) rhs_[a] -= system_(a, worst) * torque_[kw];
-    // ... and the free joints' inverse loses the held one (Schur complement), or is
-    // computed afresh should its pivot vanish.
-    const double pivot = inverse_(worst, worst);
-    if (std::isfinite(pivot) && pivot != 0) {
-      for (int a : free_)
-        for (int b : free_) inverse_(a, b) -= inverse_(a, worst) * inverse_(worst, b) / pivot;
-    } else if (!free_.empty()) {
-      const auto f = static_cast<Eigen::Index>(free_.size());
-      Eigen::MatrixXd reduced(f, f);
-      for (Eigen::Index a = 0; a < f; ++a)
-        for (Eigen::Index b = 0; b < f; ++b) reduced(a, b) = system_(free_[static_cast<size_t>(a)], free_[static_cast<size_t>(b)]);
-      const Eigen::MatrixXd inv = reduced.partialPivLu().inverse();
-      for (Eigen::Index a = 0; a < f; ++a)
-        for (Eigen::Index b = 0; b < f; ++b) inverse_(free_[static_cast<size_t>(a)], free_[static_cast<size_t>(b)]) = inv(a, b);
+    held_.push_back(worst);
+    // P_w = A^-1 s_w, then x_W from the held set.
+    const auto p = static_cast<Eigen::Index>(held_.size());
+    unit_rhs_.setZero(nv);
+    unit_rhs_[joints_[kw].dof] = 1;
+    held_response_.conservativeResize(nv, p);
+    if (symmetric) {
+      held_response_.col(p - 1) = system_llt_.solve(unit_rhs_);
+    } else {
+      held_response_.col(p - 1) = system_lu_.solve(unit_rhs_);
+    }
+    change_ = free_change_;
+    for (Eigen::Index i = 0; i < p; ++i) {
+      const size_t ki = static_cast<size_t>(held_[static_cast<size_t>(i)]);
+      change_ += held_response_.col(i) * (torque_[ki] - rhs_[static_cast<Eigen::Index>(ki)]);
+    }
+    // capacitance = I - V^T Z, Z_j = h kd_j P_j; then x_W = y + Z capacitance^-1 V^T y.
+    capacitance_.resize(p, p);
+    projected_.resize(p);
+    for (Eigen::Index i = 0; i < p; ++i) {
+      const size_t ki = static_cast<size_t>(held_[static_cast<size_t>(i)]);
+      projected_[i] = damped_velocity(ki, change_);
+      for (Eigen::Index j = 0; j < p; ++j) {
+        const size_t kj = static_cast<size_t>(held_[static_cast<size_t>(j)]);
+        capacitance_(i, j) = (i == j ? 1.0 : 0.0) -
+                             h * kd_[kj] * damped_velocity(ki, held_response_.col(j));
+      }
+    }
+    const Eigen::VectorXd weights = capacitance_.partialPivLu().solve(projected_);
+    for (Eigen::Index j = 0; j < p; ++j) {
+      const size_t kj = static_cast<size_t>(held_[static_cast<size_t>(j)]);
+      change_ += (h * kd_[kj] * weights[j]) * held_response_.col(j);
     }
   }
+}
+
+template <typename Vector>
+double JointDrive::damped_velocity(size_t k, const Vector& v) const {
+  const std::vector<DampedDof>& c = damped_[k];
+  if (c.empty()) return v[joints_[k].dof];
+  double sum = 0;
+  for (const DampedDof& t : c) sum += t.weight * v[t.dof];
+  return sum;
 }
 
 void JointDrive::make_explicit(mjModel* m, mjData* d, size_t k) {

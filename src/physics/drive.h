@@ -47,9 +47,11 @@
 //
 // (S selects the driven joints, C the velocities the dampers act on: a joint's own, or a
 // link's world pitch rate for a controller that damps that; J and R the step's
-// constraint rows and their regularization, from mj_step1). A joint whose torque would
-// pass its limit is held at the limit and the rest solved again, the furthest beyond its
-// limit first. Every joint is then applied explicitly, ctrl = tau, dof_damping 0: the net
+// constraint rows and their regularization, from mj_step1). Solved as one nv x nv system,
+// (M + J^T R^-1 J + h S^T Kd C) x = S^T (u - Kd c qdot_t), tau = u - Kd (c qdot_t + h C x),
+// factorized once a step. A joint whose torque would pass its limit is held at the limit
+// and the rest solved again, the furthest beyond its limit first (a rank-one update of
+// the factorized system per held joint). Every joint is then applied explicitly, ctrl = tau, dof_damping 0: the net
 // torque is ctrl, within the limit, and a record replays as any other.
 //
 // Why: MuJoCo's implicit damping and the stable PD above divide a joint's damper by
@@ -181,11 +183,17 @@ class JointDrive {
   std::vector<double> torque_;
   std::vector<mjtNum> row_, basis_;  // a constraint row, e_i
   std::vector<int> nonzero_;
-  Eigen::MatrixXd inertia_, response_cols_, damped_response_, system_, inverse_;
-  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  Eigen::MatrixXd inertia_, system_;  // H, and A = H + h S^T Kd C
+  Eigen::LLT<Eigen::MatrixXd> system_llt_;
   Eigen::PartialPivLU<Eigen::MatrixXd> system_lu_;
-  Eigen::VectorXd damped_velocity_, rhs_;
-  std::vector<int> free_;
+  Eigen::VectorXd rhs_, step_rhs_;           // r (per joint), S^T r
+  Eigen::VectorXd free_change_, change_;     // x with every joint free, x with W held
+  Eigen::VectorXd unit_rhs_, projected_;     // s_w; V^T y
+  Eigen::MatrixXd held_response_, capacitance_;  // [P_w]; I - V^T Z
+  std::vector<int> held_;                    // W: the joints held at their limit, in order
+  // c_k . v: joint k's damped velocity in the velocities v.
+  template <typename Vector>
+  double damped_velocity(size_t k, const Vector& v) const;
   std::vector<double> qdot_;    // per joint: qdot_t of the current step (rad/s)
   std::vector<char> explicit_;  // per joint: damping applied explicitly in the motor
   bool redone_ = false;         // the current step has been integrated again

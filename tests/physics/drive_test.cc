@@ -410,6 +410,93 @@ TEST(JointDrive, ConstrainedDampingMeetsTheInertiaTheContactsLeave) {
   EXPECT_LT(worst_constrained, 0.02);
 }
 
+// Under Damping::kConstrained every joint's torque is the solution of its own equation,
+// tau_k = u_k - kd_k c_k (qdot + h x),  H x = S^T tau,  H = M + J^T R^-1 J,
+// or is held at its limit. Checked here independently of how the drive solves it (one
+// factorization and a rank-one update per held joint): the planar human limp after a drop
+// onto its feet, standing, toppling and lying on the floor, requests drawn so that several joints saturate, some with
+// their damper on a sum of velocities (a link's world pitch rate) as the jump controller
+// asks.
+TEST(JointDrive, ConstrainedTorquesSolveTheirEquationsOrAreHeldAtTheirLimits) {
+  const Scene s = human_drop();
+  SimWorker worker(s.model);
+  set_initial_state(s, worker);
+  mjModel* m = worker.model();
+  mjData* d = worker.data();
+  const std::vector<DrivenJoint> joints = driven_joints(m);
+  const int n = static_cast<int>(joints.size()), nv = m->nv;
+  ASSERT_FALSE(mj_isSparse(m));
+  for (int i = 0; i < 400; ++i) mj_step(m, d);  // fallen: feet, knees or trunk on the floor
+  unsigned state = 12345;
+  auto uniform = [&state] {  // deterministic, in [0, 1)
+    state = state * 1664525u + 1013904223u;
+    return static_cast<double>(state >> 8) / 16777216.0;
+  };
+  int held = 0, free = 0, with_rows = 0, contact_trials = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    mj_step1(m, d);
+    if (d->nefc == 0) {  // in the air for a moment: nothing held
+      mj_step2(m, d);
+      continue;
+    }
+    ++contact_trials;
+    JointDrive drive(joints, SaturatedDrive::kExplicit, Damping::kConstrained);
+    std::vector<std::vector<DampedDof>> rows(static_cast<size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      const double limit = joints[static_cast<size_t>(k)].limit;
+      const double u = (2 * uniform() - 1) * 1.6 * limit, kd = 0.5 * limit * uniform();
+      if (trial % 2 == 1 && k % 3 == 0) {
+        // the world pitch rate of the link below: root pitch plus the joints above it
+        rows[static_cast<size_t>(k)] = {{2, 1.0}, {joints[static_cast<size_t>(k)].dof, 1.0}};
+        if (k > 0) rows[static_cast<size_t>(k)].push_back({joints[static_cast<size_t>(k - 1)].dof, -0.5});
+        drive.set(k, u, kd, rows[static_cast<size_t>(k)]);
+        ++with_rows;
+      } else {
+        drive.set(k, u, kd);
+      }
+    }
+    drive.apply(m, d);
+    // H and x = H^-1 S^T tau, from the step's constraint rows.
+    Eigen::MatrixXd H(nv, nv);
+    mj_fullM(m, H.data(), d->qM);
+    for (int i = 0; i < d->nefc; ++i)
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b)
+          H(a, b) += d->efc_J[i * nv + a] * d->efc_J[i * nv + b] / d->efc_R[i];
+    Eigen::VectorXd torque = Eigen::VectorXd::Zero(nv);
+    for (int k = 0; k < n; ++k) torque[joints[static_cast<size_t>(k)].dof] = d->ctrl[joints[static_cast<size_t>(k)].actuator];
+    const Eigen::VectorXd x = H.ldlt().solve(torque);
+    for (int k = 0; k < n; ++k) {
+      const DrivenJoint& j = joints[static_cast<size_t>(k)];
+      std::vector<DampedDof> c = rows[static_cast<size_t>(k)];
+      if (c.empty()) c = {{j.dof, 1.0}};
+      double velocity = 0, change = 0;
+      for (const DampedDof& t : c) {
+        velocity += t.weight * d->qvel[t.dof];
+        change += t.weight * x[t.dof];
+      }
+      const double tau = d->ctrl[j.actuator];
+      const double own = drive.u(k) - drive.kd(k) * (velocity + m->opt.timestep * change);
+      EXPECT_LE(std::fabs(tau), j.limit) << "joint " << k;
+      EXPECT_EQ(m->dof_damping[j.dof], 0.0);
+      if (std::fabs(tau) == j.limit) {
+        ++held;
+      } else {
+        ++free;
+        EXPECT_NEAR(tau, own, 1e-9 * j.limit) << "trial " << trial << " joint " << k;
+      }
+    }
+    // On to another lying pose: a few steps without the drawn requests.
+    for (int k = 0; k < n; ++k) d->ctrl[joints[static_cast<size_t>(k)].actuator] = 0;
+    for (int i = 0; i < 5; ++i) mj_step(m, d);
+  }
+  std::printf("%d steps with contacts: %d joint-steps held at their limit, %d solved, %d with a damped sum\n",
+              contact_trials, held, free, with_rows);
+  EXPECT_GT(contact_trials, 30);
+  EXPECT_GT(held, 40);
+  EXPECT_GT(free, 40);
+}
+
 // (e) A 1 kg block on a slide joint, no gravity: the Euler step solves
 // (m + h kd) a = ctrl - kd v0, and the net force motor + damper is m a.
 TEST(CheckNetTorque, SlidingBlockHasTheClosedFormNetForce) {
