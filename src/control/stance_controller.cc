@@ -374,6 +374,11 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
   measure(m, d);
   for (int s = 0; s < 2; ++s) stance_[static_cast<size_t>(s)] = foot_contact(d, s);
   const int legs = (stance_[0] ? 1 : 0) + (stance_[1] ? 1 : 0);
+  rows_ = drive.damping() == Damping::kConstrained;
+  if (rows_) {
+    row_.resize(static_cast<size_t>(n));
+    row_used_.assign(static_cast<size_t>(n), 0);
+  }
 
   // Support polygon, its centre, the soles' height.
   force_ = {0, 0, 0};
@@ -538,7 +543,13 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
       const double* a = d->xaxis + 3 * j.joint;
       const double kp = kp_[static_cast<size_t>(k)], kd = kd_gain_[static_cast<size_t>(k)];
-      u_[static_cast<size_t>(k)] = kp * dot3(a, e) - kd * dot3(a, w_parent);
+      // The damper on the foot's world angular velocity about the axis, a . w_parent + qdot.
+      u_[static_cast<size_t>(k)] = kp * dot3(a, e);
+      if (rows_) {
+        add_body_damping(m, d, k, m->body_parentid[foot], 1.0);
+      } else {
+        u_[static_cast<size_t>(k)] -= kd * dot3(a, w_parent);
+      }
       kd_[static_cast<size_t>(k)] = kd;
     }
   }
@@ -552,7 +563,12 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
       const double* a = d->xaxis + 3 * j.joint;
       const double kp = kp_[static_cast<size_t>(k)], kd = kd_gain_[static_cast<size_t>(k)];
-      double u = kp * dot3(a, e) - kd * dot3(a, w_parent);
+      double u = kp * dot3(a, e);
+      if (rows_) {
+        add_body_damping(m, d, k, m->body_parentid[torso_body_], 1.0);
+      } else {
+        u -= kd * dot3(a, w_parent);
+      }
       if (gains_.gravity_compensation) u += gravity_torque(m, d, j, gravity_);
       u_[static_cast<size_t>(k)] = u;
       kd_[static_cast<size_t>(k)] = kd;
@@ -577,7 +593,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
       if (leg >= 0 && stance_[static_cast<size_t>(leg)]) continue;
       const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
       const double tau =
-          std::clamp(u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * d->qvel[j.dof],
+          std::clamp(u_[static_cast<size_t>(k)] - kd_[static_cast<size_t>(k)] * damped_velocity_now(d, k),
                      -j.torque_limit, j.torque_limit);
       const double* a = d->xaxis + 3 * j.joint;
       for (int i = 0; i < 3; ++i) torque[i] += tau * a[i];
@@ -605,16 +621,63 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
           // identity a . w_root = a . w_thigh - qdot (the hinges of a universal joint are
           // orthogonal): its -qdot part is the hip's own damping, implicit in the drive.
           const double* w_child = d->cvel + 6 * j.body;
-          u_[static_cast<size_t>(k)] = jt + w * root_kd_ * dot3(a, w_child);
+          u_[static_cast<size_t>(k)] = jt;
           kd_[static_cast<size_t>(k)] = w * root_kd_;
+          if (rows_) {
+            row_used_[static_cast<size_t>(k)] = 0;  // replaces the joint PD's damper
+            add_body_damping(m, d, k, j.body, -1.0);
+          } else {
+            u_[static_cast<size_t>(k)] += w * root_kd_ * dot3(a, w_child);
+          }
         } else {
-          u_[static_cast<size_t>(k)] += jt + w * root_kd_ * dot3(a, w_root);
+          const double kd = kd_[static_cast<size_t>(k)];
+          if (rows_ && kd > 0) {
+            u_[static_cast<size_t>(k)] += jt;
+            add_body_damping(m, d, k, root, -w * root_kd_ / kd);
+          } else {
+            u_[static_cast<size_t>(k)] += jt + w * root_kd_ * dot3(a, w_root);
+          }
         }
       }
     }
   }
 
-  for (int k = 0; k < n; ++k) drive.set(k, u_[static_cast<size_t>(k)], kd_[static_cast<size_t>(k)]);
+  for (int k = 0; k < n; ++k) {
+    const size_t kk = static_cast<size_t>(k);
+    if (!rows_ || !row_used_[kk]) {
+      drive.set(k, u_[kk], kd_[kk]);
+      continue;
+    }
+    damped_.clear();
+    const std::vector<double>& row = row_[kk];
+    for (int i = 0; i < m->nv; ++i) {
+      const double weight = row[static_cast<size_t>(i)] + (i == body_.joints[kk].dof ? 1.0 : 0.0);
+      if (weight != 0) damped_.push_back({i, weight});
+    }
+    drive.set(k, u_[kk], kd_[kk], damped_);
+  }
+}
+
+void StanceController::add_body_damping(const mjModel* m, const mjData* d, int k, int body, double weight) {
+  const size_t kk = static_cast<size_t>(k), nv = static_cast<size_t>(m->nv);
+  std::vector<double>& row = row_[kk];
+  if (!row_used_[kk]) row.assign(nv, 0.0);
+  row_used_[kk] = 1;
+  jacr_.resize(3 * nv);
+  mj_jacBody(m, d, nullptr, jacr_.data(), body);  // w_body = jacr qvel, world frame
+  const double* a = d->xaxis + 3 * body_.joints[kk].joint;
+  for (size_t i = 0; i < nv; ++i)
+    row[i] += weight * (a[0] * jacr_[i] + a[1] * jacr_[nv + i] + a[2] * jacr_[2 * nv + i]);
+}
+
+double StanceController::damped_velocity_now(const mjData* d, int k) const {
+  const size_t kk = static_cast<size_t>(k);
+  const int dof = body_.joints[kk].dof;
+  if (!rows_ || !row_used_[kk]) return d->qvel[dof];
+  double v = d->qvel[dof];
+  const std::vector<double>& row = row_[kk];
+  for (size_t i = 0; i < row.size(); ++i) v += row[i] * d->qvel[i];
+  return v;
 }
 
 }  // namespace diverse

@@ -234,6 +234,19 @@ class StanceController {
   std::array<std::array<double, 3>, 2> leg_cop_{};    // m, where it acts (on the ground)
   double yaw_force_ = 0;                               // N, the yaw push D (left +, right -)
   std::vector<double> u_, kd_;
+  // Under Damping::kConstrained the world-frame dampers are rows of the drive's solve
+  // (physics/drive.h): per joint, its damped velocity's weights over the dofs (its own
+  // qdot plus the world angular velocities it damps about its axis); `row_used_` marks the
+  // joints that have one this step.
+  bool rows_ = false;
+  std::vector<std::vector<double>> row_;
+  std::vector<char> row_used_;
+  std::vector<mjtNum> jacr_;  // 3 x nv scratch
+  std::vector<DampedDof> damped_;
+  // Adds weight * (a_k . w_body) to joint k's damped velocity (a_k its world axis).
+  void add_body_damping(const mjModel* m, const mjData* d, int k, int body, double weight);
+  // Joint k's damped velocity now: qdot_k, or its row times qvel.
+  double damped_velocity_now(const mjData* d, int k) const;
 };
 
 }  // namespace diverse

@@ -55,10 +55,10 @@ Loaded load(const std::string& name) {
   return l;
 }
 
-JointDrive drive_for(const Character& body) {
+JointDrive drive_for(const Character& body, Damping damping = Damping::kMujoco) {
   std::vector<DrivenJoint> joints;
   for (const CharacterJoint& j : body.joints) joints.push_back({j.actuator, j.dof, j.torque_limit});
-  return JointDrive(std::move(joints));
+  return JointDrive(std::move(joints), SaturatedDrive::kExplicit, damping);
 }
 
 // What the rollout saw.
@@ -147,7 +147,7 @@ class StanceHooks : public StepHooks {
 // Runs `seconds` from the standing pose with the root's linear velocity `v` (world),
 // keeping the qpos at the steps in `capture`.
 Outcome stand(const Loaded& c, const std::array<double, 3>& v, double seconds,
-              const std::vector<int>& capture = {}) {
+              const std::vector<int>& capture = {}, Damping damping = Damping::kMujoco) {
   SimWorker worker(c.model);
   worker.reset();
   mjModel* m = worker.model();
@@ -158,7 +158,7 @@ Outcome stand(const Loaded& c, const std::array<double, 3>& v, double seconds,
   for (int i = 0; i < 3; ++i) d->qvel[c.body.root_dof + i] = v[static_cast<size_t>(i)];
   mj_forward(m, d);
   stance.reset(m, d);
-  JointDrive drive = drive_for(c.body);
+  JointDrive drive = drive_for(c.body, damping);
   Outcome out;
   StanceHooks hooks(c.body, stance, drive, out);
   hooks.capture = capture;
@@ -298,6 +298,21 @@ TEST_P(Stance3d, RecoversFromAPushSideways) {
   const Outcome right = stand(c, {0, -0.3, 0}, 10.0);
   std::printf("%s right 0.3 m/s: %s\n", GetParam(), describe(right).c_str());
   expect_stood(right, "0.3 m/s to the right");
+}
+
+// Under constrained damping (physics/drive.h) the stance controller's world-frame dampers
+// (the feet's and the torso's world angular velocities about each joint's axis, the root's
+// damping shared by the stance legs) are rows of the drive's solve, so that they act on the
+// end-of-step velocities the contacts allow, as the planar jump's world-pitch dampers do.
+// The character stands and recovers from each push as under MuJoCo's damping.
+TEST_P(Stance3d, StandsAndRecoversUnderConstrainedDamping) {
+  const Loaded c = load(GetParam());
+  for (const std::array<double, 3>& v : std::vector<std::array<double, 3>>{
+           {0, 0, 0}, {0.3, 0, 0}, {-0.3, 0, 0}, {0, 0.3, 0}, {0, -0.3, 0}}) {
+    const Outcome o = stand(c, v, 10.0, {}, Damping::kConstrained);
+    std::printf("%s (%.1f, %.1f) m/s, constrained damping: %s\n", GetParam(), v[0], v[1], describe(o).c_str());
+    expect_stood(o, "constrained damping");
+  }
 }
 
 // A film strip of each character standing and recovering from the three pushes, at
