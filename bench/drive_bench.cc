@@ -2,11 +2,13 @@
 // from 0.4 m onto its feet (a landing impact, where integrations are redone) through
 // run_rollout() with a JointDrive, the same PD applied the old way (ctrl = clamp(tau) +
 // kd qdot with implicit dof_damping, no drive), and raw mj_step replaying the drive
-// rollout's recorded inputs, i.e. the physics of exactly that motion. The three run
-// interleaved within each iteration and are timed by thread CPU time, so load from other
-// processes on the machine shifts all three alike. Counters: drive_per_raw and
-// old_per_raw are throughputs relative to raw mj_step (1 = no overhead), redone the
-// fraction of steps integrated more than once.
+// rollout's recorded inputs, i.e. the physics of exactly that motion; and the same PD
+// under Damping::kConstrained (every joint's torque solved on the inertia the step's
+// contacts leave) against raw mj_step replaying its own record. All run interleaved within
+// each iteration and are timed by thread CPU time, so load from other processes on the
+// machine shifts them alike. Counters: drive_per_raw, old_per_raw and constrained_per_raw
+// are throughputs relative to raw mj_step (1 = no overhead), redone the fraction of steps
+// integrated more than once.
 //
 //   diverse_bench --benchmark_filter=DriveOverhead
 #include <benchmark/benchmark.h>
@@ -93,6 +95,27 @@ void drop(SimWorker& w) {
   w.data()->qpos[m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "rootz")]] = 0.4;
 }
 
+// Thread CPU seconds of raw mj_step replaying a record's inputs from the drop.
+double raw_seconds(SimWorker& worker, const StepRecorder& record) {
+  drop(worker);
+  mjModel* m = worker.model();
+  mjData* d = worker.data();
+  const double t0 = thread_seconds();
+  size_t change = 0;
+  for (int k = 0; k < record.steps(); ++k) {
+    while (change < record.damping.size() && record.damping[change].step == k) {
+      for (int j = 0; j < record.ndamp; ++j)
+        m->dof_damping[record.damped_dofs[static_cast<size_t>(j)]] = record.damping[change].values[static_cast<size_t>(j)];
+      ++change;
+    }
+    std::copy_n(record.ctrl.begin() + static_cast<long>(k) * m->nu, m->nu, d->ctrl);
+    mj_step(m, d);
+  }
+  const double seconds = thread_seconds() - t0;
+  benchmark::DoNotOptimize(d->qpos[0]);
+  return seconds;
+}
+
 void BM_DriveOverhead(benchmark::State& state) {
   auto model = SharedModel::from_file(kHuman);
   SimWorker worker(model);
@@ -105,7 +128,13 @@ void BM_DriveOverhead(benchmark::State& state) {
   run_rollout(worker, driven, kSteps, drive, &record);
   drive.reset_counts();
 
-  double t_drive = 0, t_old = 0, t_raw = 0;
+  JointDrive constrained(crouch.joints, SaturatedDrive::kExplicit, Damping::kConstrained);
+  DrivenCrouch driven_constrained(crouch, &constrained);
+  StepRecorder constrained_record;
+  drop(worker);
+  run_rollout(worker, driven_constrained, kSteps, constrained, &constrained_record);
+
+  double t_drive = 0, t_old = 0, t_raw = 0, t_constrained = 0, t_raw_constrained = 0;
   long long steps = 0;
   for (auto _ : state) {
     drop(worker);
@@ -118,23 +147,15 @@ void BM_DriveOverhead(benchmark::State& state) {
     const RolloutStats b = run_rollout(worker, old, kSteps, crouch.dofs, nullptr);
     t_old += thread_seconds() - t0;
 
+    t_raw += raw_seconds(worker, record);
+
     drop(worker);
-    mjModel* m = worker.model();
-    mjData* d = worker.data();
     t0 = thread_seconds();
-    size_t change = 0;
-    for (int k = 0; k < record.steps(); ++k) {
-      while (change < record.damping.size() && record.damping[change].step == k) {
-        for (int j = 0; j < record.ndamp; ++j)
-          m->dof_damping[record.damped_dofs[static_cast<size_t>(j)]] = record.damping[change].values[static_cast<size_t>(j)];
-        ++change;
-      }
-      std::copy_n(record.ctrl.begin() + static_cast<long>(k) * m->nu, m->nu, d->ctrl);
-      mj_step(m, d);
-    }
-    t_raw += thread_seconds() - t0;
-    benchmark::DoNotOptimize(d->qpos[0]);
-    benchmark::DoNotOptimize(a.steps + b.steps);
+    const RolloutStats c = run_rollout(worker, driven_constrained, kSteps, constrained, nullptr);
+    t_constrained += thread_seconds() - t0;
+    t_raw_constrained += raw_seconds(worker, constrained_record);
+
+    benchmark::DoNotOptimize(a.steps + b.steps + c.steps);
     steps += kSteps;
   }
   const double n = static_cast<double>(steps);
@@ -143,6 +164,7 @@ void BM_DriveOverhead(benchmark::State& state) {
   state.counters["old_steps_per_s"] = n / t_old;
   state.counters["drive_per_raw"] = t_raw / t_drive;
   state.counters["old_per_raw"] = t_raw / t_old;
+  state.counters["constrained_per_raw"] = t_raw_constrained / t_constrained;
   state.counters["redone"] = static_cast<double>(drive.counts().redone_steps) /
                              static_cast<double>(std::max(1L, drive.counts().steps));
 }
