@@ -10,8 +10,8 @@
 # (DIVERSE=path picks the `diverse` binary; default build/diverse. TASK=name runs another
 # task than the backflip, e.g. to try the script quickly. SEEDS="1 2" runs and reports
 # only those seeds, so a long comparison can be made a pair of runs at a time.)
-# At 500 generations one backflip run (2 ms, stable PD) takes about 9 minutes on an idle
-# 2-core machine (round-robin, seed 1: 512.9 s), so the ten take about an hour and a half. The script
+# At 500 generations one backflip run (2 ms, constrained damping) takes about 10 minutes on
+# an idle 2-core machine (round-robin, seed 1: 625.9 s), so the ten take under two hours. The script
 # can be stopped at any moment and started again with the same arguments: a finished
 # run with the same settings is kept, an interrupted one continues from its checkpoint
 # (`diverse resume`, same result as uninterrupted), anything else is run afresh.

@@ -75,7 +75,12 @@
 // Damping. A term's derivative part on a link's world rate, -kd (a . w_child), is split into
 // the joint's own rate, -kd qdot (which the drive integrates implicitly), and
 // -kd (a . w_parent) in u (a . w_child = a . w_parent + qdot for the orthogonal hinges of a
-// universal joint), so large gains stay stable at a 2 ms step.
+// universal joint), so large gains stay stable at a 2 ms step. Under constrained damping
+// (physics/drive.h, Damping::kConstrained) the whole derivative part is a row of the
+// drive's solve instead: joint k's damped velocity is qdot_k plus a_k . w of each body it
+// damps (w = J_rot qvel, mj_jacBody), including the root's damping the stance legs share,
+// so the dampers act on the end-of-step velocities the contacts allow; the torque at the
+// step's velocities is the same either way.
 //
 // The start pose: standing_pose() leans the legs of qpos0 about the feet until the COM is
 // over the middle of the soles (a human's COM at qpos0 is over its ankles, 7 cm from the
