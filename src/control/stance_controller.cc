@@ -378,6 +378,7 @@ void StanceController::control(const mjModel* m, const mjData* d, JointDrive& dr
   if (rows_) {
     row_.resize(static_cast<size_t>(n));
     row_used_.assign(static_cast<size_t>(n), 0);
+    jacobian_bodies_.clear();
   }
 
   // Support polygon, its centre, the soles' height.
@@ -663,11 +664,19 @@ void StanceController::add_body_damping(const mjModel* m, const mjData* d, int k
   std::vector<double>& row = row_[kk];
   if (!row_used_[kk]) row.assign(nv, 0.0);
   row_used_[kk] = 1;
-  jacr_.resize(3 * nv);
-  mj_jacBody(m, d, nullptr, jacr_.data(), body);  // w_body = jacr qvel, world frame
+  // w_body = J qvel (world frame), J from mj_jacBody once a step per body.
+  size_t slot = 0;
+  while (slot < jacobian_bodies_.size() && jacobian_bodies_[slot] != body) ++slot;
+  if (slot == jacobian_bodies_.size()) {
+    jacobian_bodies_.push_back(body);
+    if (jacobians_.size() <= slot) jacobians_.resize(slot + 1);
+    jacobians_[slot].resize(3 * nv);
+    mj_jacBody(m, d, nullptr, jacobians_[slot].data(), body);
+  }
+  const std::vector<mjtNum>& jacr = jacobians_[slot];
   const double* a = d->xaxis + 3 * body_.joints[kk].joint;
   for (size_t i = 0; i < nv; ++i)
-    row[i] += weight * (a[0] * jacr_[i] + a[1] * jacr_[nv + i] + a[2] * jacr_[2 * nv + i]);
+    row[i] += weight * (a[0] * jacr[i] + a[1] * jacr[nv + i] + a[2] * jacr[2 * nv + i]);
 }
 
 double StanceController::damped_velocity_now(const mjData* d, int k) const {

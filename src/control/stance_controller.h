@@ -246,7 +246,8 @@ class StanceController {
   bool rows_ = false;
   std::vector<std::vector<double>> row_;
   std::vector<char> row_used_;
-  std::vector<mjtNum> jacr_;  // 3 x nv scratch
+  std::vector<int> jacobian_bodies_;              // bodies whose J_rot this step holds
+  std::vector<std::vector<mjtNum>> jacobians_;   // their 3 x nv J_rot, the same order
   std::vector<DampedDof> damped_;
   // Adds weight * (a_k . w_body) to joint k's damped velocity (a_k its world axis).
   void add_body_damping(const mjModel* m, const mjData* d, int k, int body, double weight);

@@ -130,13 +130,8 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   bool symmetric = true;
   for (int k = 0; k < n; ++k) {
     const size_t kk = static_cast<size_t>(k);
-    const std::vector<DampedDof>& c = damped_[kk];
-    double velocity = d->qvel[joints_[kk].dof];
-    if (!c.empty()) {
-      symmetric = false;
-      velocity = 0;
-      for (const DampedDof& t : c) velocity += t.weight * d->qvel[t.dof];
-    }
+    if (!damped_[kk].empty()) symmetric = false;
+    const double velocity = damped_velocity(kk, d->qvel);
     const double kd = kd_[kk];
     rhs_[k] = kd >= 0 && std::isfinite(kd) ? u_[kk] - kd * velocity
                                            : std::numeric_limits<double>::quiet_NaN();
@@ -178,6 +173,8 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
   }
   change_ = free_change_;
   held_.clear();
+  held_response_.resize(nv, n);  // columns 0..p-1 in use: P_w of the held joints, in order
+  capacitance_.resize(n, n);     // its top-left p x p block in use
   for (int round = 0; round <= n; ++round) {
     int worst = -1;
     double worst_ratio = 1;
@@ -201,7 +198,6 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
     const auto p = static_cast<Eigen::Index>(held_.size());
     unit_rhs_.setZero(nv);
     unit_rhs_[joints_[kw].dof] = 1;
-    held_response_.conservativeResize(nv, p);
     if (symmetric) {
       held_response_.col(p - 1) = system_llt_.solve(unit_rhs_);
     } else {
@@ -212,22 +208,25 @@ void JointDrive::solve_constrained(const mjModel* m, mjData* d) {
       const size_t ki = static_cast<size_t>(held_[static_cast<size_t>(i)]);
       change_ += held_response_.col(i) * (torque_[ki] - rhs_[static_cast<Eigen::Index>(ki)]);
     }
-    // capacitance = I - V^T Z, Z_j = h kd_j P_j; then x_W = y + Z capacitance^-1 V^T y.
-    capacitance_.resize(p, p);
-    projected_.resize(p);
+    // capacitance = I - V^T Z, Z_j = h kd_j P_j (only the new joint's row and column are
+    // new); then x_W = y + Z capacitance^-1 V^T y.
     for (Eigen::Index i = 0; i < p; ++i) {
       const size_t ki = static_cast<size_t>(held_[static_cast<size_t>(i)]);
-      projected_[i] = damped_velocity(ki, change_);
       for (Eigen::Index j = 0; j < p; ++j) {
+        if (i != p - 1 && j != p - 1) continue;
         const size_t kj = static_cast<size_t>(held_[static_cast<size_t>(j)]);
         capacitance_(i, j) = (i == j ? 1.0 : 0.0) -
                              h * kd_[kj] * damped_velocity(ki, held_response_.col(j));
       }
     }
-    const Eigen::VectorXd weights = capacitance_.partialPivLu().solve(projected_);
+    projected_.resize(p);
+    for (Eigen::Index i = 0; i < p; ++i)
+      projected_[i] = damped_velocity(static_cast<size_t>(held_[static_cast<size_t>(i)]), change_);
+    capacitance_lu_.compute(capacitance_.topLeftCorner(p, p));
+    weights_ = capacitance_lu_.solve(projected_);
     for (Eigen::Index j = 0; j < p; ++j) {
       const size_t kj = static_cast<size_t>(held_[static_cast<size_t>(j)]);
-      change_ += (h * kd_[kj] * weights[j]) * held_response_.col(j);
+      change_ += (h * kd_[kj] * weights_[j]) * held_response_.col(j);
     }
   }
 }

@@ -188,8 +188,9 @@ class JointDrive {
   Eigen::PartialPivLU<Eigen::MatrixXd> system_lu_;
   Eigen::VectorXd rhs_, step_rhs_;           // r (per joint), S^T r
   Eigen::VectorXd free_change_, change_;     // x with every joint free, x with W held
-  Eigen::VectorXd unit_rhs_, projected_;     // s_w; V^T y
-  Eigen::MatrixXd held_response_, capacitance_;  // [P_w]; I - V^T Z
+  Eigen::VectorXd unit_rhs_, projected_, weights_;  // s_w; V^T y; capacitance^-1 V^T y
+  Eigen::MatrixXd held_response_, capacitance_;     // [P_w]; I - V^T Z
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_lu_;
   std::vector<int> held_;                    // W: the joints held at their limit, in order
   // c_k . v: joint k's damped velocity in the velocities v.
   template <typename Vector>
