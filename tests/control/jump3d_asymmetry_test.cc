@@ -40,9 +40,12 @@ std::string read(const std::string& path) {
   return s.str();
 }
 
-// tasks/NAME.toml with absolute paths and its `asymmetric = true` line replaced by `line`.
+// tasks/NAME.toml with absolute paths, its `asymmetric = true` line replaced by `line`, and
+// under MuJoCo's damping, under which the input motions kept here were found (a task file
+// that asks for `damping = "constrained"` has that line dropped).
 std::string task_variant(const std::string& name, const std::string& line) {
   std::string t = read(kRoot + "/tasks/" + name + ".toml");
+  t = std::regex_replace(t, std::regex("\ndamping = \"constrained\""), "\n");
   t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + kRoot + "/assets/");
   t = std::regex_replace(t, std::regex("m0 = \""), "m0 = \"" + kRoot + "/tasks/");
   t = std::regex_replace(t, std::regex("base = \""), "base = \"" + kRoot + "/tasks/");
@@ -58,7 +61,7 @@ std::string task_variant(const std::string& name, const std::string& line) {
 }
 
 Task symmetric_task(const std::string& name) { return load_task(task_variant(name, "asymmetric = false")); }
-Task asymmetric_task(const std::string& name) { return load_task(kRoot + "/tasks/" + name + ".toml"); }
+Task asymmetric_task(const std::string& name) { return load_task(task_variant(name, "asymmetric = true")); }
 std::string old_m0(const std::string& name) { return kData + name + ".m0.symmetric.json"; }
 // The input motion as first converted for the split controller (each side the shared
 // value): the task's m0 until a search of its own replaced it; robot_jump's still is.

@@ -112,8 +112,10 @@ TEST(BalancedRest, NeighboursThatMeetTheTaskDoNotToppleLater) {
 }
 
 // The capture point: over the feet of the high jump's input motion at rest, beyond the
-// toes when the COM moves forward at 1 m/s, behind the heels at 1 m/s backwards; the same
-// for the 3D human's backwards jump, and sideways too. No foot contact: -infinity.
+// toes when the COM moves forward at 1.5 m/s, behind the heels at 1.5 m/s backwards; the
+// same for the 3D human's backwards jump, and sideways too (at 1 m/s its input motion,
+// which comes to rest in a stride, one foot ahead of the other, still has its capture
+// point over its feet: 0.3 m ahead of the COM). No foot contact: -infinity.
 TEST(BalancedRest, CapturePointMarginAtRest) {
   for (const char* name : {"jump_high", "jump_backwards"}) {
     const Task task = load_task(kTasks + name + ".toml");
@@ -134,8 +136,8 @@ TEST(BalancedRest, CapturePointMarginAtRest) {
     const double still = capture_point_margin(m, d, ev.body(), com, {0, 0, 0});
     EXPECT_GT(still, 0.0) << name;
     EXPECT_LT(still, 0.2) << name << ": half a foot's length at most";
-    EXPECT_LT(capture_point_margin(m, d, ev.body(), com, {1, 0, 0}), 0.0) << name;
-    EXPECT_LT(capture_point_margin(m, d, ev.body(), com, {-1, 0, 0}), 0.0) << name;
+    EXPECT_LT(capture_point_margin(m, d, ev.body(), com, {1.5, 0, 0}), 0.0) << name;
+    EXPECT_LT(capture_point_margin(m, d, ev.body(), com, {-1.5, 0, 0}), 0.0) << name;
     const double sideways = capture_point_margin(m, d, ev.body(), com, {0, 1, 0});
     if (ev.body().root == RootKind::kPlanar) {
       EXPECT_EQ(sideways, still) << name << ": the planar character cannot fall sideways";
