@@ -162,7 +162,7 @@ void read_simulation(const TomlReader& r, Task& task) {
   r.only({"settle_time", "settle_speed", "settle_max", "max_time", "fall_com_height",
           "fall_tilt", "clearance_range", "timestep", "balanced_rest",
           "rest_hold", "hop_is_fall", "topple_distance",
-          "topple_after", "saturated_drive", "damping"});
+          "topple_after", "saturated_drive", "damping", "friction_cone"});
   TaskSimulation& s = task.simulation;
   s.settle_time = r.number("settle_time", 1.0, 10, s.settle_time);
   s.settle_speed = r.number("settle_speed", 0.01, 5, s.settle_speed);
@@ -193,6 +193,11 @@ void read_simulation(const TomlReader& r, Task& task) {
     } else {
       r.fail("damping", "expected \"mujoco\" or \"constrained\", got \"" + way + "\"");
     }
+  }
+  if (r.has("friction_cone")) {
+    s.friction_cone = r.string("friction_cone");
+    if (s.friction_cone != "elliptic" && s.friction_cone != "pyramidal")
+      r.fail("friction_cone", "expected \"elliptic\" or \"pyramidal\", got \"" + s.friction_cone + "\"");
   }
   s.max_time = r.number("max_time", 0.5, 60, s.max_time);
   s.fall_com_height = r.number("fall_com_height", 0, 1.5, s.fall_com_height);
@@ -334,6 +339,26 @@ std::string scale_force_ranges(const std::string& xml, double factor, const std:
   return out;
 }
 
+// Sets attribute `name` of the model's <option> element to `value`, replacing the model's
+// own or adding it (and the element, if the model has none).
+void set_option_attribute(std::string& xml, const std::string& name, const std::string& value) {
+  const size_t option = xml.find("<option");
+  if (option == std::string::npos) {
+    const size_t root = xml.find('>', xml.find("<mujoco"));
+    xml.insert(root + 1, "\n  <option " + name + "=\"" + value + "\"/>");
+    return;
+  }
+  const size_t end = xml.find('>', option);
+  size_t attr = xml.find(" " + name + "=\"", option);
+  if (attr == std::string::npos || attr > end) attr = xml.find("\t" + name + "=\"", option);
+  if (attr != std::string::npos && attr < end) {
+    const size_t begin = attr + name.size() + 3;
+    xml.replace(begin, xml.find('"', begin) - begin, value);
+  } else {
+    xml.insert(option + 7, " " + name + "=\"" + value + "\"");
+  }
+}
+
 }  // namespace
 
 std::string scene_xml(const Task& task) {
@@ -360,25 +385,12 @@ std::string scene_xml(const Task& task) {
   }
   xml.insert(at, geoms.str());
   if (task.simulation.timestep > 0) {
-    // Override the timestep attribute of <option> (added if the model has none).
     std::ostringstream value;
     value.precision(17);
     value << task.simulation.timestep;
-    const size_t option = xml.find("<option");
-    if (option == std::string::npos) {
-      const size_t root = xml.find('>', xml.find("<mujoco"));
-      xml.insert(root + 1, "\n  <option timestep=\"" + value.str() + "\"/>");
-    } else {
-      const size_t end = xml.find('>', option);
-      const size_t attr = xml.find("timestep=\"", option);
-      if (attr != std::string::npos && attr < end) {
-        const size_t begin = attr + 10;
-        xml.replace(begin, xml.find('"', begin) - begin, value.str());
-      } else {
-        xml.insert(option + 7, " timestep=\"" + value.str() + "\"");
-      }
-    }
+    set_option_attribute(xml, "timestep", value.str());
   }
+  if (!task.simulation.friction_cone.empty()) set_option_attribute(xml, "cone", task.simulation.friction_cone);
   return xml;
 }
 

@@ -128,6 +128,11 @@ struct TaskSimulation {
   // a motion then converges as the step shrinks: docs/robustness.md, "A drive that
   // converges"). saturated_drive has no say under "constrained".
   Damping damping = Damping::kMujoco;
+  // The friction cone of every contact, MuJoCo's <option cone>: "" (the default: the
+  // model's own), "elliptic" or "pyramidal". The planar human's model has the elliptic
+  // one; under the pyramidal cone a change of friction that makes nothing slide still
+  // changes a push-off (docs/robustness.md, "Friction cones").
+  std::string friction_cone;
 };
 
 struct TaskSeed {

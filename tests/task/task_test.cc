@@ -227,6 +227,17 @@ TEST_F(TaskFileTest, Damping) {
             "driven that way); remove it");
 }
 
+TEST_F(TaskFileTest, FrictionCone) {
+  EXPECT_EQ(load_task(write(valid_text())).simulation.friction_cone, "");
+  EXPECT_EQ(load_task(write(valid_text() + "[simulation]\nfriction_cone = \"pyramidal\"\n")).simulation.friction_cone,
+            "pyramidal");
+  EXPECT_EQ(load_task(write(valid_text() + "[simulation]\nfriction_cone = \"elliptic\"\n")).simulation.friction_cone,
+            "elliptic");
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\nfriction_cone = \"conical\"\n"),
+            ": simulation.friction_cone: expected \"elliptic\" or \"pyramidal\", got \"conical\"");
+  EXPECT_EQ(error_of(valid_text() + "[simulation]\nfriction_cone = 2\n"), ": simulation.friction_cone: expected a string");
+}
+
 TEST_F(TaskFileTest, ModelPathMissing) {
   const std::string e = error_of(replace(valid_text(), "human2d.xml", "nobody.xml"));
   EXPECT_EQ(e.rfind(": character: expected an existing file (relative to the task file), but ", 0), 0u) << e;
