@@ -115,6 +115,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerConfig::with_landing_heigh
 
 std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const TomlReader& r) const {
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
+          "open_turn",
           "balance_kp",
           "balance_kd", "balance_max_force", "gravity_compensation", "stance_landing",
           "stand_after", "stand_duration", "level_feet", "landing_reach",
@@ -126,6 +127,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->tuck_time = r.number("tuck_time", 0, 1, c->tuck_time);
   c->open_time = r.number("open_time", 0, 1, c->open_time);
   c->open_rotation = r.number("open_rotation", 0, 4 * M_PI, c->open_rotation);  // rad, like the task's rotation
+  c->open_turn = r.number("open_turn", 0, 4 * M_PI, c->open_turn);  // rad
   c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
@@ -270,6 +272,7 @@ void JumpController::set_parameters(const std::vector<double>& values) {
 
 void JumpController::reset(const mjModel* m, const mjData* d) {
   com_velocity_ = SubtreeComVelocity(m, body_.root_body);
+  centroidal_ = CentroidalPitchOf(m, body_.root_body);
   q_ = d->qpos;
   from_is_world_ = true;  // start is a stance phase
   for (size_t i = 0; i < body_.joints.size(); ++i) {
@@ -315,7 +318,7 @@ void JumpController::enter(int phase, double time) {
       if (config_.tuck_time > 0) phase_duration_ = std::min(phase_duration_, config_.tuck_time);
       break;
     case kFall:
-      if (config_.open_rotation > 0) {
+      if (config_.open_rotation > 0 || config_.open_turn > 0) {
         // Possibly past the peak: the time back to take-off height from here.
         const double down = std::max(-com_vel_[2], 0.0);
         const double above = std::max(com_[2] - takeoff_com_z_, 0.01);
@@ -430,6 +433,22 @@ double JumpController::landing_hip_goal(int j, const mjData* d) const {
   return wrap(thigh - parent_pitch(j, d->qpos));
 }
 
+// open_turn, in the rise past the peak: would the body as a whole, opened now, have turned
+// as far as asked in the air by touch-down (or is touch-down no more than open_time away)?
+// `now` is the body's spin in this step.
+bool JumpController::time_to_open(const CentroidalPitch& now) const {
+  const double vz = com_vel_[2];
+  const double above = std::max(com_[2] - takeoff_com_z_, 0.0);
+  const double t_down = (vz + std::sqrt(vz * vz + 2 * gravity_ * above)) / gravity_;
+  if (t_down <= config_.open_time || now.inertia <= 0 || takeoff_inertia_ <= 0) return true;
+  // Opening over open_time, the inertia going from the tuck's to the open body's (the
+  // mean of the two rates), then open until touch-down.
+  const double opening = config_.open_time;
+  const double turn = now.momentum * (0.5 * opening * (1 / now.inertia + 1 / takeoff_inertia_) +
+                                      (t_down - opening) / takeoff_inertia_);
+  return flight_turn_ + turn >= config_.open_turn;
+}
+
 void JumpController::control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) {
   const double t = d->time;
   const double* q = d->qpos;
@@ -454,6 +473,11 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
       if (contacts.any) free_since_ = -1;
       else if (free_since_ < 0) free_since_ = t;
       if (free_since_ >= 0 && t - free_since_ >= config_.airborne_time - 1e-9 && com_vel_[2] > 0) {
+        if (config_.open_turn > 0) {
+          takeoff_inertia_ = centroidal_(m, d, com_.data(), com_vel_.data()).inertia;
+          flight_turn_ = 0;
+          spin_time_ = t;
+        }
         enter(kRise, t);
       } else if (elapsed >= config_.extend_timeout) {
         extend_timed_out_ = true;
@@ -461,13 +485,19 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
       }
       break;
     case kRise:
+      if (config_.open_turn > 0) {  // the body's turn since take-off: its mean rate, integrated
+        spin_ = centroidal_(m, d, com_.data(), com_vel_.data());
+        flight_turn_ += spin_.rate() * (t - spin_time_);
+        spin_time_ = t;
+      }
       if (contacts.any) {
         // Touched down while still rising (a low, flat jump): the peak and the landing
         // coincide, a zero-length fall, so every jump has both airborne phases.
         times_.begin[kFall] = t;
         enter(kLand, t);
       } else if (com_vel_[2] <= 0 &&
-                 std::fabs(q[body_.root_pitch_qpos] - takeoff_pitch_) >= config_.open_rotation) {
+                 std::fabs(q[body_.root_pitch_qpos] - takeoff_pitch_) >= config_.open_rotation &&
+                 (config_.open_turn <= 0 || time_to_open(spin_))) {
         enter(kFall, t);
       }
       break;

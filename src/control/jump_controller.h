@@ -9,11 +9,12 @@
 //           ends when the character is airborne (no contact with anything for
 //           airborne_time, COM rising)
 //   rise    flight, ends at peak height (COM vertical velocity <= 0), or with the config's
-//           open_rotation once the root has also turned that far since take-off; duration
+//           open_rotation once the root has also turned that far since take-off, with its
+//           open_turn once the body, opened now, would turn that far by touch-down; duration
 //           predicted as v_z / g at take-off (targets reached sooner with tuck_time)
 //   fall    flight, ends at the first contact; duration predicted as the ballistic time
 //           back to take-off height, sqrt(2 (z_peak - z_takeoff) / g) from the peak (from
-//           the current height and fall speed when open_rotation ends the rise later;
+//           the current height and fall speed when open_rotation or open_turn ends the rise later;
 //           targets reached sooner with open_time); optional landing controller (below)
 //   land    stance, balance, targets interpolated over land.duration, then held (with
 //           the config's stance_landing, by stance control; with stand_after, then
@@ -69,6 +70,7 @@
 #include "control/controller.h"
 #include "control/parameters.h"
 #include "control/stance_controller.h"
+#include "physics/centroidal.h"
 #include "physics/com_velocity.h"
 
 namespace diverse {
@@ -101,6 +103,16 @@ struct JumpControllerConfig : ControllerConfig {
   // far since take-off, so a flip opens for its landing when it has come round, as a
   // gymnast opens when the floor comes into view; 0 = the fall phase begins at the peak.
   double open_rotation = 0;
+  // rad; > 0: the rise phase (a tuck) lasts past the peak until the body as a whole,
+  // opened now, would have turned this far in the air by touch-down, and no longer than
+  // until touch-down is open_time away. The body's turn is its mean pitch rate (its angular
+  // momentum about its COM over its inertia there, physics/centroidal.h) integrated from
+  // take-off; the prediction adds what the momentum, constant in flight, turns it through
+  // opening over open_time and then open (with the inertia it had at take-off) until the
+  // COM is back at its take-off height. A flip that took off with less spin stays tucked
+  // longer, one with more opens sooner, as a gymnast spots the landing. With open_rotation
+  // as well, the root must also have turned that far since take-off.
+  double open_turn = 0;
   // true: the land phase runs stance control (control/stance_controller.h), as the 3D
   // jumps' does: the J^T force on the COM held so that its centre of pressure stays inside
   // the soles, the pelvis's world pitch held by the stance legs, the feet tracking theirs, the chest
@@ -176,6 +188,7 @@ class JumpController : public Controller {
  private:
   enum class Tracked { kNone, kParent, kChild };  // world-pitch tracking in stance
   void enter(int phase, double time);
+  bool time_to_open(const CentroidalPitch& now) const;
   double parent_pitch(int j, const double* qpos) const;
   double to_local(int j, const double* qpos, double world) const;
   double to_world(int j, const double* qpos, double local) const;
@@ -205,6 +218,11 @@ class JumpController : public Controller {
   double phase_begin_ = 0, phase_duration_ = 1;
   double takeoff_com_z_ = 0;
   double takeoff_pitch_ = 0;  // root pitch at take-off (rad, unwrapped)
+  // open_turn: the body's inertia about its COM at take-off (kg m^2), its turn since
+  // take-off (rad), when that was last brought up to date (s) and its spin in this step.
+  double takeoff_inertia_ = 0, flight_turn_ = 0, spin_time_ = 0;
+  CentroidalPitch spin_;
+  CentroidalPitchOf centroidal_;  // of the character's subtree, set by reset()
   double free_since_ = -1;  // time contact was last lost during extend (s), -1 if touching
   PhaseTimes times_;
   // Per joint: target at the start of the phase (rad); in stance phases the world pitch

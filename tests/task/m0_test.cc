@@ -65,9 +65,9 @@ class M0 : public ::testing::TestWithParam<const char*> {};
 
 // Of `count` perturbations at `sigma`, at least `met` meet the task as the diversity
 // optimizer judges samples (at both timesteps where the task has the half-timestep
-// check). The backflip's and jump_over's neighbourhoods are the thinnest, which is why
-// their task files start diversity runs at a much smaller sigma0 (0.005 and 0.003); the
-// bounds sit at or below what the committed M0s measure (the backflip: 24 at 0.01;
+// check). jump_over's neighbourhood is the thinnest, which is why its task file starts
+// diversity runs at a much smaller sigma0 (0.003); the bounds sit at or below what the
+// committed M0s measure (the backflip: 19 at 0.02;
 // jump_forward: 19 at 0.02; jump_onto: 17 at 0.02; jump_over: 11 at 0.002; jump_high: 22
 // at 0.02).
 struct Neighbourhood {
@@ -75,7 +75,7 @@ struct Neighbourhood {
   int count, met;
 };
 const std::map<std::string, Neighbourhood> kNeighbourhood = {
-    {"backflip", {0.01, 32, 20}},
+    {"backflip", {0.02, 32, 16}},
     {"jump_forward", {0.02, 32, 16}},
     {"jump_onto", {0.02, 32, 15}},
     {"jump_over", {0.002, 32, 9}},
@@ -152,8 +152,8 @@ TEST(M0Specifics, BackflipTurnsOverOnce) {
   const SimRun r = simulate("backflip");
   // One full backward turn from standing to standing (the task's tolerance), at least 300
   // degrees of it in the air between take-off and touch-down (the task's flight-rotation
-  // constraint, which the task file must carry). The committed M0 turns 372 degrees in all
-  // and 314 in flight, and comes to rest balanced 4 cm behind where it touched down, inside
+  // constraint, which the task file must carry). The committed M0 turns 375 degrees in all
+  // and 319 in flight, and comes to rest balanced 2 cm behind where it touched down, inside
   // the landing box.
   const Task task = load_task(kTasks + "backflip.toml");
   EXPECT_NEAR(task.constraints.min_flight_rotation, 300 * M_PI / 180, 1e-3);
