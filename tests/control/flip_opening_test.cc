@@ -7,12 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
 #include "task/task.h"
@@ -20,30 +19,12 @@
 namespace diverse {
 namespace {
 
-namespace fs = std::filesystem;
-const std::string kSource = DIVERSE_SOURCE_DIR;
+const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
-// backflip.toml with its open_turn line replaced by `lines`, written to a scratch
-// directory with its relative paths made absolute.
-fs::path variant(const std::string& name, const std::string& lines) {
-  std::ifstream in(kSource + "/tasks/backflip.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("backflip.toml has no " + from);
-    text.replace(at, from.size(), to);
-  };
-  const auto at = text.find("\nopen_turn =");
-  if (at == std::string::npos) throw std::runtime_error("backflip.toml has no open_turn");
-  text.replace(at + 1, text.find('\n', at + 1) - at, lines + "\n");
-  replace("character = \"../", "character = \"" + kSource + "/");
-  replace("m0 = \"", "m0 = \"" + kSource + "/tasks/");
-  replace("base = \"", "base = \"" + kSource + "/tasks/");
-  const fs::path dir = fs::temp_directory_path() / "diverse_flip_opening";
-  fs::create_directories(dir);
-  const fs::path file = dir / (name + ".toml");
-  std::ofstream(file) << text;
-  return file;
+// backflip.toml with its open_turn line replaced by `lines`.
+std::string variant(const std::string& name, const std::string& lines) {
+  return test_files::task_variant("backflip", "flip_opening_" + name, {"open_turn ="}, {{"controller", lines}})
+      .string();
 }
 
 struct Landings {
@@ -74,8 +55,8 @@ Landings land(const Task& task, const std::vector<Eigen::VectorXd>& xs) {
 }
 
 TEST(FlipOpening, SpotsTheLanding) {
-  const Task spotted = load_task(kSource + "/tasks/backflip.toml");
-  const Task clocked = load_task(variant("rotation", "open_rotation = 3.3").string());
+  const Task spotted = load_task(kTasks + "backflip.toml");
+  const Task clocked = load_task(variant("rotation", "open_rotation = 3.3"));
   const TaskEvaluator ev(spotted);
   const ParameterSet m0 = ev.load_parameters(spotted.m0);
   const std::vector<Eigen::VectorXd> xs = perturb(m0.normalized(), 0.02, 32, robustness_seed(spotted, 0.02));
@@ -92,7 +73,7 @@ TEST(FlipOpening, SpotsTheLanding) {
 TEST(FlipOpening, BadValuesAreRefused) {
   auto refused = [](const std::string& lines, const std::string& expected) {
     try {
-      load_task(variant("bad", lines).string());
+      load_task(variant("bad", lines));
       ADD_FAILURE() << "expected a UserError for " << lines;
     } catch (const UserError& e) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();

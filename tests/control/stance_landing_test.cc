@@ -6,44 +6,22 @@
 // of the two keys are refused with the task file's field.
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "core/error.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
 namespace diverse {
 namespace {
 
-namespace fs = std::filesystem;
-const std::string kSource = DIVERSE_SOURCE_DIR;
-
-// jump_forward.toml with `lines` at the top of its [controller] table, written to a
-// scratch directory with its relative paths made absolute.
-fs::path variant(const std::string& name, const std::string& lines) {
-  std::ifstream in(kSource + "/tasks/jump_forward.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("jump_forward.toml has no " + from);
-    text.replace(at, from.size(), to);
-  };
-  // The committed file's own landing keys give way to the variant's.
-  for (const char* key : {"stance_landing =", "stand_after =", "stand_duration ="}) {
-    for (auto at = text.find(std::string("\n") + key); at != std::string::npos; at = text.find(std::string("\n") + key))
-      text.erase(at + 1, text.find('\n', at + 1) - at);
-  }
-  replace("character = \"../", "character = \"" + kSource + "/");
-  replace("m0 = \"", "m0 = \"" + kSource + "/tasks/");
-  replace("base = \"", "base = \"" + kSource + "/tasks/");
-  replace("[controller]\n", "[controller]\n" + lines + "\n");
-  const fs::path dir = fs::temp_directory_path() / "diverse_stance_landing";
-  fs::create_directories(dir);
-  const fs::path file = dir / (name + ".toml");
-  std::ofstream(file) << text;
-  return file;
+// jump_forward.toml with `lines` at the top of its [controller] table in place of the
+// committed file's own landing keys.
+std::string variant(const std::string& name, const std::string& lines) {
+  return test_files::task_variant("jump_forward", "stance_landing_" + name,
+                                  {"stance_landing =", "stand_after =", "stand_duration ="}, {{"controller", lines}})
+      .string();
 }
 
 EvaluationOptions judged() {
@@ -54,8 +32,8 @@ EvaluationOptions judged() {
 }
 
 TEST(StanceLanding, MeetsTheTaskAndHoldsForwardPushesAfterTouchdown) {
-  const Task paper_task = load_task(variant("paper", "stance_landing = false\nstand_after = -1").string());
-  const Task stance_task = load_task(variant("stance", "stance_landing = true\nstand_after = 0.0").string());
+  const Task paper_task = load_task(variant("paper", "stance_landing = false\nstand_after = -1"));
+  const Task stance_task = load_task(variant("stance", "stance_landing = true\nstand_after = 0.0"));
   const TaskEvaluator paper(paper_task), stance(stance_task);
   const ParameterSet m0 = paper.load_parameters(paper_task.m0);
   auto pw = paper.make_worker();
@@ -91,7 +69,7 @@ TEST(StanceLanding, MeetsTheTaskAndHoldsForwardPushesAfterTouchdown) {
 TEST(StanceLanding, BadSettingsAreRefused) {
   auto refused = [](const std::string& lines, const std::string& expected) {
     try {
-      load_task(variant("bad", lines).string());
+      load_task(variant("bad", lines));
       ADD_FAILURE() << "expected a UserError for " << lines;
     } catch (const UserError& e) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
