@@ -67,7 +67,7 @@ class M0 : public ::testing::TestWithParam<const char*> {};
 // optimizer judges samples (at both timesteps where the task has the half-timestep
 // check). jump_over's neighbourhood is the thinnest, which is why its task file starts
 // diversity runs at a much smaller sigma0 (0.003); the bounds sit at or below what the
-// committed M0s measure (the backflip: 19 at 0.02;
+// committed M0s measure (the backflip: 28 at 0.02;
 // jump_forward: 19 at 0.02; jump_onto: 17 at 0.02; jump_over: 11 at 0.002; jump_high: 22
 // at 0.02).
 struct Neighbourhood {
@@ -152,8 +152,8 @@ TEST(M0Specifics, BackflipTurnsOverOnce) {
   const SimRun r = simulate("backflip");
   // One full backward turn from standing to standing (the task's tolerance), at least 300
   // degrees of it in the air between take-off and touch-down (the task's flight-rotation
-  // constraint, which the task file must carry). The committed M0 turns 375 degrees in all
-  // and 319 in flight, and comes to rest balanced 2 cm behind where it touched down, inside
+  // constraint, which the task file must carry). The committed M0 turns 374 degrees in all
+  // and 312 in flight, and comes to rest balanced 1 cm behind where it touched down, inside
   // the landing box.
   const Task task = load_task(kTasks + "backflip.toml");
   EXPECT_NEAR(task.constraints.min_flight_rotation, 300 * M_PI / 180, 1e-3);
