@@ -272,7 +272,7 @@ void JumpController::set_parameters(const std::vector<double>& values) {
 
 void JumpController::reset(const mjModel* m, const mjData* d) {
   com_velocity_ = SubtreeComVelocity(m, body_.root_body);
-  centroidal_ = CentroidalPitchOf(m, body_.root_body);
+  if (config_.open_turn > 0) centroidal_ = CentroidalPitchOf(m, body_.root_body);
   q_ = d->qpos;
   from_is_world_ = true;  // start is a stance phase
   for (size_t i = 0; i < body_.joints.size(); ++i) {

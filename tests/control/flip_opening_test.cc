@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "support/task_errors.h"
 #include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
@@ -76,12 +77,7 @@ TEST(FlipOpening, SpotsTheLanding) {
 
 TEST(FlipOpening, BadValuesAreRefused) {
   auto refused = [](const std::string& lines, const std::string& expected) {
-    try {
-      load_task(variant("bad", lines));
-      ADD_FAILURE() << "expected a UserError for " << lines;
-    } catch (const UserError& e) {
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
-    }
+    test_files::expect_task_refused(variant("bad", lines), expected);
   };
   refused("open_turn = -1", "controller.open_turn: expected a number in");
   refused("open_turn = 20", "controller.open_turn: expected a number in");
