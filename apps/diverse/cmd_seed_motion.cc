@@ -40,6 +40,8 @@ struct SeedArgs {
   double sigma = 0;
   int perturbations = 0;
   double perturbation_sigma = 0.02;
+  int pushes = 0;
+  double push_speed = 0.3;
   int selection_samples = 32;
   std::string objective = "mean";
   double min_flight_rotation_deg = 0;
@@ -67,6 +69,12 @@ std::string searched_options(const SeedArgs& args) {
   if (args.perturbations > 0) {
     options += " --perturbations " + std::to_string(args.perturbations) + " --perturbation-sigma " +
                number(args.perturbation_sigma);
+  }
+  if (args.pushes > 0) {
+    options += " --pushes " + std::to_string(args.pushes);
+    if (args.push_speed != 0.3) options += " --push-speed " + number(args.push_speed);
+  }
+  if (args.perturbations > 0 || args.pushes > 0) {
     if (args.selection_samples != 32) options += " --selection-samples " + std::to_string(args.selection_samples);
     if (args.objective != "mean") options += " --objective " + args.objective;
   }
@@ -181,6 +189,8 @@ void run(const SeedArgs& args) {
   options.sigma = args.sigma;
   options.perturbations = args.perturbations;
   options.perturbation_sigma = args.perturbation_sigma;
+  options.pushes = args.pushes;
+  options.push_speed = args.push_speed;
   options.selection_samples = args.selection_samples;
   options.objective = args.objective == "share" ? SeedObjective::kShare : SeedObjective::kMeanC;
   options.min_flight_rotation = args.min_flight_rotation_deg * M_PI / 180;
@@ -242,7 +252,7 @@ void run(const SeedArgs& args) {
     j["task"] = task.name;
     j["constraint"] = constraint;
     j["margin"] = r.margin;
-    if (args.perturbations > 0) j["robustness"] = r.robustness;
+    if (args.perturbations > 0 || args.pushes > 0) j["robustness"] = r.robustness;
     if (!r.selected.empty())
       j["selection"] = {{"candidates", r.selection_candidates}, {"chosen", r.selected},
                         {"samples", args.selection_samples}};
@@ -262,7 +272,7 @@ void run(const SeedArgs& args) {
   std::printf("C=%.6g margin=%.3f robustness=%.3f fell=%d evaluations=%lld seconds=%.1f%s -> %s\n",
               r.constraint, r.margin, r.robustness, r.fell ? 1 : 0, r.evaluations, r.seconds, robust.c_str(),
               out.c_str());
-  if (met && !r.lowest_mean_meets && args.perturbations > 0) {
+  if (met && !r.lowest_mean_meets && (args.perturbations > 0 || args.pushes > 0)) {
     nlohmann::json j;
     j["task"] = task.name;
     j["objective"] = r.lowest_mean_f;
@@ -308,6 +318,13 @@ void install(CLI::App& app) {
   cmd->add_option("--perturbation-sigma", args->perturbation_sigma,
                   "Robustness term: their standard deviation, in normalized units")
       ->check(number_in(1e-6, 1.0));
+  cmd->add_option("--pushes", args->pushes,
+                  "Robustness term: pushed rollouts per candidate, drawn as the robustness suite "
+                  "draws its pushes (0 = off; docs/robustness.md)")
+      ->check(integer_in(0, 1000));
+  cmd->add_option("--push-speed", args->push_speed, "Robustness term: the pushes' change of the root's speed (m/s)")
+      ->capture_default_str()
+      ->check(number_in(1e-6, 10.0));
   cmd->add_option("--selection-samples", args->selection_samples,
                   "Robustness term: the result is chosen among the last stage's six best "
                   "candidates, the CMA-ES mean and the start by how many of this many further "

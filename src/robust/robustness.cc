@@ -7,46 +7,10 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "task/pushes.h"
 
 namespace diverse {
 namespace {
-
-// A window of simulated time (s) and the name of the ground phase it covers.
-struct GroundWindow {
-  double begin = 0, end = 0;
-  const char* phase = "motion";
-};
-
-// The ground phases pushes are drawn in (see the header): two for a jump, one for a walk.
-std::array<GroundWindow, 2> ground_windows(const Task& task, const Evaluation& e) {
-  const double end = std::max(e.stats.time, 0.0);
-  const GroundWindow whole{0, end, "motion"};
-  if (task.walk.enabled) {
-    const auto& steps = e.summary.walk.steps;
-    const auto settle = static_cast<std::size_t>(std::max(0, task.walk.settle_steps));
-    if (steps.size() > settle) {
-      const double begin = settle > 0 ? steps[settle - 1].time : 0.0;
-      const double last = steps.back().time;
-      if (last > begin) return {GroundWindow{begin, last, "steps"}, GroundWindow{begin, last, "steps"}};
-    }
-    return {whole, whole};
-  }
-  const double takeoff = e.phases.rise >= 0 ? e.phases.takeoff() : -1;
-  const double landing = e.phases.land >= 0 ? e.phases.landing() : -1;
-  const GroundWindow before = takeoff > 0 ? GroundWindow{0, takeoff, "takeoff"} : whole;
-  GroundWindow after = before;
-  if (landing >= 0 && landing < end) {
-    after = GroundWindow{landing, std::min(end, landing + task.simulation.settle_time), "landing"};
-  }
-  return {before, after};
-}
-
-struct Direction {
-  const char* name;
-  std::array<double, 3> axis;
-};
-constexpr Direction kDirections[4] = {
-    {"forward", {1, 0, 0}}, {"backward", {-1, 0, 0}}, {"left", {0, 1, 0}}, {"right", {0, -1, 0}}};
 
 // One perturbed rollout to run: its options and parameters, and what to report of it.
 struct Job {
@@ -91,12 +55,12 @@ std::vector<Job> make_jobs(const TaskEvaluator& evaluator, const MotionUnderTest
     jobs.push_back(std::move(job));
   }
   const bool planar = evaluator.body().root == RootKind::kPlanar;
-  const int directions = planar ? 2 : 4;
-  const std::array<GroundWindow, 2> windows = ground_windows(evaluator.task(), base);
+  const int directions = push_directions(planar);
+  const GroundWindows windows = ground_windows(evaluator.task(), base);
   for (int s = 0; s < suite.push_samples; ++s) {
     Rng rng(derive_seed(suite.seed, {index, static_cast<std::uint64_t>(PerturbationKind::kPush),
                                      static_cast<std::uint64_t>(s)}));
-    const Direction& dir = kDirections[s % directions];
+    const PushDirection& dir = push_direction(s, planar);
     const GroundWindow& w = windows[static_cast<std::size_t>((s / directions + suite.first_push_phase) % 2)];
     Job job;
     job.motion = m;
@@ -273,7 +237,7 @@ nlohmann::json robustness_json(const TaskEvaluator& evaluator, const RobustnessS
                                const std::vector<MotionRobustness>& results) {
   const bool planar = evaluator.body().root == RootKind::kPlanar;
   nlohmann::json directions = nlohmann::json::array();
-  for (int k = 0; k < (planar ? 2 : 4); ++k) directions.push_back(kDirections[k].name);
+  for (int k = 0; k < push_directions(planar); ++k) directions.push_back(push_direction(k, planar).name);
   nlohmann::json out = {
       {"format", "diverse.robustness"},
       {"version", 1},

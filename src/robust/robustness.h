@@ -16,7 +16,8 @@
 //                  optimizer's CMA-ES does (optimize/cmaes.h: period 2, x -> -x below 0,
 //                  x -> 2 - x above 1), so no sample is skipped or clipped.
 //   pushes         `push_samples` rollouts with the root's linear velocity changed once by
-//                  `push_speed` (EvaluationOptions::push, task/evaluate.h): directions
+//                  `push_speed` (EvaluationOptions::push, task/evaluate.h; where and which
+//                  way: task/pushes.h): directions
 //                  forward (+x, where every character faces at the start), backward,
 //                  and for a 3D root left (+y) and right, in turn; a planar root is pushed
 //                  forward and backward only, in its plane. The moment is drawn uniformly
@@ -50,8 +51,9 @@
 // timestep checks of the rollouts that hold on a task that asks for them, plus one
 // unperturbed rollout. docs/robustness.md has the measurements of every task's M0.
 //
-// The push and the friction exist only here: the optimizer, the input-motion search and
-// a run never set them (EvaluationOptions defaults to none).
+// The push and the friction are the world's, never a controller's: the optimizer and a
+// run never set them (EvaluationOptions defaults to none), and the input-motion search
+// pushes its candidates only with `--pushes`, drawn as here (task/pushes.h), to rank them.
 #pragma once
 
 #include <array>

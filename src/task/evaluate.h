@@ -69,10 +69,11 @@ struct EvaluationOptions {
   // Motion files, the robustness suite and the input-motion search simulate every
   // rollout to its end.
   bool end_when_decided = false;
-  // Perturbations of the robustness suite (robust/robustness.h), never set by the
-  // optimizer, the input-motion search or a run: they are disturbances from the world
-  // that only the suite applies. A perturbed rollout cannot be recorded (its record would
-  // not replay on the saved model): asking for both is a std::logic_error.
+  // Perturbations of the robustness suite (robust/robustness.h): disturbances from the
+  // world, never applied by a controller, never set by the optimizer or a run, and set by
+  // the input-motion search only to rank its candidates (task/seed_motion.h, "Pushes").
+  // A perturbed rollout cannot be recorded (its record would not replay on the saved
+  // model): asking for both is a std::logic_error.
   //
   // Every geom's friction coefficients (sliding, torsional, rolling) times this, on the
   // worker's model copy for the rollout only (SimWorker::reset restores them). MuJoCo

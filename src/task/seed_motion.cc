@@ -16,6 +16,7 @@
 #include "core/thread_pool.h"
 #include "optimize/cmaes.h"
 #include "task/evaluate.h"
+#include "task/pushes.h"
 
 namespace diverse {
 namespace {
@@ -26,6 +27,7 @@ constexpr int kPatience = 25;       // generations without improvement that end 
 constexpr std::uint64_t kSeedPerturbations = 0x73656564726f62;
 constexpr std::uint64_t kMeasurePerturbations = 0x6d656173726f62;
 constexpr std::uint64_t kSelectPerturbations = 0x73656c6563726f62;  // "selecrob"
+constexpr std::uint64_t kPushMoments = 0x7075736865;                  // "pushe"
 // Candidates of the last stage that met the task kept for the selection (seed_motion.h).
 constexpr size_t kFinalists = 6;
 
@@ -55,11 +57,26 @@ Eigen::VectorXd displaced(const Eigen::VectorXd& x, double sigma, const Eigen::V
 }
 
 // What the objective needs besides the evaluators: the robustness term's fixed
-// perturbation directions (empty = off) and their scale.
+// perturbation directions (empty = off) and their scale, and its pushes (empty = off):
+// for push k, where in its ground phase it falls (a fraction of the phase), its
+// direction and phase by k (task/pushes.h), and its speed.
 struct Robustness {
   std::vector<Eigen::VectorXd> directions;
   double sigma = 0;
+  std::vector<double> push_moments;  // in [0, 1)
+  double push_speed = 0;
+  std::size_t rollouts() const { return directions.size() + push_moments.size(); }
 };
+
+// `count` fractions in [0, 1), fraction k from derive_seed(seed, {k}).
+std::vector<double> moments(int count, std::uint64_t seed) {
+  std::vector<double> out;
+  for (int k = 0; k < count; ++k) {
+    Rng rng(derive_seed(seed, {static_cast<std::uint64_t>(k)}));
+    out.push_back(rng.uniform());
+  }
+  return out;
+}
 
 // The perturbation directions of generation `generation` (0: the starting point) of
 // continuation stage `stage`: shared by the generation's candidates, fresh in every
@@ -72,7 +89,19 @@ Robustness generation_robustness(const Task& task, int dim, const SeedOptions& o
       directions(dim, options.perturbations,
                  derive_seed(task.seed.seed, {kSeedPerturbations, stage,
                                               static_cast<std::uint64_t>(generation)}));
+  r.push_speed = options.push_speed;
+  r.push_moments = moments(options.pushes, derive_seed(task.seed.seed, {kPushMoments, stage,
+                                                                        static_cast<std::uint64_t>(generation)}));
   return r;
+}
+
+// The selection's pushes: as many as keep the search's ratio of pushes to perturbations
+// (selection_samples of them without perturbations).
+int selection_pushes(const SeedOptions& options) {
+  if (options.pushes <= 0) return 0;
+  if (options.perturbations <= 0) return options.selection_samples;
+  return std::max(1, static_cast<int>(std::lround(static_cast<double>(options.selection_samples) *
+                                                  options.pushes / options.perturbations)));
 }
 
 // The selection's perturbation directions (seed_motion.h, "Choosing the result"): fixed
@@ -83,7 +112,9 @@ std::uint64_t selection_seed(const Task& task) { return derive_seed(task.seed.se
 Robustness selection_robustness(const Task& task, int dim, const SeedOptions& options) {
   Robustness r;
   r.sigma = options.perturbation_sigma;
-  r.directions = directions(dim, options.selection_samples, selection_seed(task));
+  r.directions = directions(dim, options.perturbations > 0 ? options.selection_samples : 0, selection_seed(task));
+  r.push_speed = options.push_speed;
+  r.push_moments = moments(selection_pushes(options), derive_seed(task.seed.seed, {kSelectPerturbations, kPushMoments}));
   return r;
 }
 
@@ -199,7 +230,24 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
     sum += term(c);
     if (c == 0) ++met;
   }
-  const auto n = static_cast<double>(robust.directions.size());
+  // Pushes, each in a ground phase of this candidate's own rollout (seed_motion.h).
+  if (!robust.push_moments.empty()) {
+    const GroundWindows windows = ground_windows(ev.task(), e);
+    const bool planar = ev.body().root == RootKind::kPlanar;
+    const int round = push_directions(planar);
+    for (std::size_t k = 0; k < robust.push_moments.size(); ++k) {
+      const int i = static_cast<int>(k);
+      const GroundWindow& w = windows[static_cast<std::size_t>((i / round) % 2)];
+      EvaluationOptions pushed = perturbed;
+      pushed.push.time = w.begin + robust.push_moments[k] * (w.end - w.begin);
+      const PushDirection& d = push_direction(i, planar);
+      for (std::size_t a = 0; a < 3; ++a) pushed.push.dv[a] = robust.push_speed * d.axis[a];
+      const double c = seed_constraint(ev.evaluate_normalized(x, worker, pushed), ev.task(), seed);
+      sum += term(c);
+      if (c == 0) ++met;
+    }
+  }
+  const auto n = static_cast<double>(robust.rollouts());
   if (n > 0) s.met = met / n;
   s.f = sum / (2 + n);
   if (sum == 0) s.f = -ev.task().seed.robustness * std::min(std::max(s.margin, 0.0), kMarginCap);
@@ -284,6 +332,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     SeedOptions stage_options = options;
     if (!last) {
       stage_options.perturbations = 0;
+      stage_options.pushes = 0;
       stage_options.requirement = {};
     }
     const int dim = static_cast<int>(x.size());
@@ -296,7 +345,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
     bool have_valid = best.meets();
     Scored best_valid = best;
     Eigen::VectorXd best_valid_x = x;
-    result.evaluations += static_cast<long long>(2 + robust.directions.size()) + best.check_rollouts;
+    result.evaluations += static_cast<long long>(2 + robust.rollouts()) + best.check_rollouts;
     auto count_check = [&](const Scored& s) {
       result.requirement_checks += s.checked ? 1 : 0;
       result.requirement_held += s.checked && s.held ? 1 : 0;
@@ -316,7 +365,8 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       result.lowest_mean_meets = best.meets();
     }
     // The selection's candidates (seed_motion.h, "Choosing the result").
-    const bool select = last && stage_options.perturbations > 0 && stage_options.selection_samples > 0;
+    const bool select = last && (stage_options.perturbations > 0 || stage_options.pushes > 0) &&
+                        stage_options.selection_samples > 0;
     std::vector<Finalist> finalists;
     const Eigen::VectorXd stage_start = x;
     const bool stage_start_meets = best.meets();
@@ -375,7 +425,7 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
           improved = true;
         }
       }
-      result.evaluations += static_cast<long long>(xs.size() * (2 + robust.directions.size())) + check_rollouts;
+      result.evaluations += static_cast<long long>(xs.size() * (2 + robust.rollouts())) + check_rollouts;
       es.tell(f);
       since_improvement = improved ? 0 : since_improvement + 1;
       if (options.log) {
@@ -416,9 +466,9 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
       std::string compared;
       for (size_t k = 0; k < finalists.size(); ++k) {
         const Scored& j = judged[k];
-        result.evaluations += static_cast<long long>(2 + selection.directions.size()) + j.check_rollouts;
+        result.evaluations += static_cast<long long>(2 + selection.rollouts()) + j.check_rollouts;
         count_check(j);
-        const int held = static_cast<int>(std::lround(j.met * static_cast<double>(selection.directions.size())));
+        const int held = static_cast<int>(std::lround(j.met * static_cast<double>(selection.rollouts())));
         compared += (k ? ", " : "") + finalists[k].label + " " +
                     (j.meets() ? std::to_string(held) : std::string("misses the task"));
         if (!j.meets()) continue;
@@ -434,8 +484,10 @@ SeedResult seed_motion(const Task& task, const ParameterSet& start, const SeedOp
         result.robustness = judged[c].met;
       }
       if (options.log) {
-        options.log("selection on " + std::to_string(selection.directions.size()) +
-                    " perturbations of each (meeting the task): " + compared + "; chosen: " +
+        const std::string pushes =
+            selection.push_moments.empty() ? "" : " and " + std::to_string(selection.push_moments.size()) + " pushes";
+        options.log("selection on " + std::to_string(selection.directions.size()) + " perturbations" + pushes +
+                    " of each (meeting the task): " + compared + "; chosen: " +
                     (chosen >= 0 ? result.selected : std::string("none meets the task")));
       }
     }

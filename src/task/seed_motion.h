@@ -52,6 +52,21 @@
 // plus log(1 + C) / 100 (at most about 0.12), 0 if it meets it: f is the share of the
 // rollouts that miss, the misses ranked among themselves by how far they miss.
 //
+// Pushes (SeedOptions::pushes = K > 0; `--pushes K`): robust controller optimization
+// evaluates each candidate over several disturbed rollouts (Wang, Fleet and Hertzmann
+// 2010), and what input motions fail most in the robustness suite is its pushes. With
+// K > 0 every candidate of the last stage is also simulated K times with the root's
+// linear velocity changed once by push_speed, exactly as the suite pushes
+// (task/pushes.h): directions in turn (forward, backward; and left, right for a 3D root),
+// the ground phase alternating after every round of directions (a jump's take-off phase,
+// then its landing; a walk's evaluated steps), the moment drawn uniformly in the phase
+// of the candidate's own unperturbed rollout. The moments' fractions are shared by the
+// generation's candidates and fresh in every generation, as the perturbation directions
+// are; each pushed rollout is judged with the half-timestep check where the task asks for
+// it, and adds its term to the objective like a perturbation. A push is a disturbance
+// from the world used to rank candidates only: the motion written is never pushed, and
+// neither the controller nor a run applies one.
+//
 // A requirement beyond the task (SeedOptions::requirement; `diverse seed-motion --robust`
 // sets it to the robustness suite's small part, robust/robustness.h robust_sample_suite()):
 // a candidate of the last stage that meets the task at both timesteps (C = 0) meets it
@@ -107,9 +122,14 @@ struct SeedOptions {
   // standard deviation in normalized units.
   int perturbations = 0;
   double perturbation_sigma = 0.02;
+  // Push term (see "Pushes" above): pushed rollouts per candidate (0 = off) and the change
+  // of the root's speed they make (m/s, the robustness suite's 0.3 by default).
+  int pushes = 0;
+  double push_speed = 0.3;
   // The selection that chooses the result among the last stage's best candidates (see
-  // above): its perturbations at perturbation_sigma (0 = off: the candidate with the
-  // lowest objective is the result). Only with perturbations > 0.
+  // above): its perturbations at perturbation_sigma, with pushes as many pushes as keep
+  // the search's ratio of pushes to perturbations (0 = off: the candidate with the
+  // lowest objective is the result). Only with perturbations or pushes > 0.
   int selection_samples = 32;
   // How the rollouts of a candidate make its objective (see above).
   SeedObjective objective = SeedObjective::kMeanC;
@@ -136,8 +156,8 @@ struct SeedResult {
   double constraint = 0;  // C of the result on the full task (sum over both timesteps,
                           // plus the requirement's penalty when it fails it)
   double margin = 0;      // constraint_margin of the result (m)
-  double robustness = 0;  // fraction of the last stage's fixed perturbations met (0 if off);
-                          // with a selection, of the selection's perturbations
+  double robustness = 0;  // fraction of the last stage's fixed perturbations (and pushes)
+                          // met (0 if off); with a selection, of the selection's
   // The selection (perturbations > 0 and selection_samples > 0): how many candidates it
   // compared and which it chose ("start", "CMA-ES mean", "generation G"); empty if none ran.
   int selection_candidates = 0;
@@ -150,7 +170,7 @@ struct SeedResult {
   bool requirement_failed = false;
   long long requirement_checks = 0;
   long long requirement_held = 0;
-  // Rollouts simulated: 2 + perturbations per candidate, plus the requirement's.
+  // Rollouts simulated: 2 + perturbations + pushes per candidate, plus the requirement's.
   long long evaluations = 0;
   // The last stage's candidate with the lowest objective, whether or not it meets the task
   // (with perturbations, a robust near miss can rank above a fragile motion that meets

@@ -192,6 +192,39 @@ TEST(SeedMotion, TheRobustnessTermGivesTheSameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(two.evaluations, one.evaluations);
 }
 
+// The push term (SeedOptions::pushes): every candidate is also simulated with its root
+// pushed, as the robustness suite pushes, and the pushed rollouts count in the objective
+// and in the share of the robustness rollouts that meet the task. A push too small to
+// matter leaves the high jump's input motion meeting the task in nearly every one; a push
+// of 3 m/s, which no standing or landing human holds, in nearly none. Each candidate costs
+// its two rollouts (both timesteps) and one per push.
+TEST(SeedMotion, PushesAreSimulatedAndCountInTheObjectiveAndTheShare) {
+  const Task task = load_task(kTasks + "jump_high.toml");
+  const TaskEvaluator ev(task);
+  const ParameterSet m0 = ev.load_parameters(task.m0);
+  SeedOptions options;
+  options.threads = 2;
+  options.generations = 1;
+  options.sigma = 1e-4;  // candidates next to the input motion, which holds pushes it cannot feel
+  options.pushes = 6;
+  options.selection_samples = 0;
+  options.objective = SeedObjective::kShare;
+  options.push_speed = 1e-6;
+  const SeedResult gentle = seed_motion(task, m0, options);
+  options.push_speed = 3.0;
+  const SeedResult hard = seed_motion(task, m0, options);
+  EXPECT_EQ(gentle.constraint, 0.0);
+  EXPECT_GE(gentle.robustness, 5.0 / 6.0);
+  EXPECT_LE(hard.robustness, 1.0 / 6.0);
+  // The start, the generation and the result, each at both timesteps and at its 6 pushes.
+  EXPECT_EQ(gentle.evaluations, 8 * (1 + task.seed.popsize));
+  // The same on two threads as on one.
+  options.threads = 1;
+  const SeedResult one = seed_motion(task, m0, options);
+  EXPECT_EQ(one.parameters.values(), hard.parameters.values());
+  EXPECT_EQ(one.robustness, hard.robustness);
+}
+
 // The share objective counts the rollouts that miss the task, and ranks the misses among
 // themselves: a near miss (C = 25, a landing 7 cm out) costs about as much as a fall, and
 // a candidate with half its rollouts meeting ranks above one whose rollouts all miss
