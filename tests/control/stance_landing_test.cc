@@ -1,5 +1,7 @@
 // "jump2d" with stance_landing and stand_after (control/jump_controller.h): the land phase
-// run by stance control, then standing up. On jump_forward's input motion: it still meets
+// run by stance control, then standing up. On jump_forward's input motion found under the
+// default balance servo (tests/control/data/jump_forward.default_servo.m0.json, the task's
+// before it took the stiffer servo, with the task's servo keys removed): it still meets
 // the task at both timesteps, and it holds pushes forward 0.3 to 0.9 s after touch-down,
 // where the paper's land phase (PD toward the land pose plus J^T balance) does not even
 // come to rest balanced without a push. Bad settings
@@ -21,7 +23,9 @@ namespace {
 // committed file's own landing keys.
 std::string variant(const std::string& name, const std::string& lines) {
   return test_files::task_variant("jump_forward", "stance_landing_" + name,
-                                  {"stance_landing =", "stand_after =", "stand_duration ="}, {{"controller", lines}})
+                                  {"stance_landing =", "stand_after =", "stand_duration =", "balance_kp =",
+                                   "balance_kd =", "balance_max_force ="},
+                                  {{"controller", lines}})
       .string();
 }
 
@@ -36,7 +40,8 @@ TEST(StanceLanding, MeetsTheTaskAndHoldsForwardPushesAfterTouchdown) {
   const Task paper_task = load_task(variant("paper", "stance_landing = false\nstand_after = -1"));
   const Task stance_task = load_task(variant("stance", "stance_landing = true\nstand_after = 0.0"));
   const TaskEvaluator paper(paper_task), stance(stance_task);
-  const ParameterSet m0 = paper.load_parameters(paper_task.m0);
+  const ParameterSet m0 = paper.load_parameters(std::string(DIVERSE_SOURCE_DIR) +
+                                                "/tests/control/data/jump_forward.default_servo.m0.json");
   auto pw = paper.make_worker();
   auto sw = stance.make_worker();
   const Evaluation p0 = paper.evaluate(m0.values(), *pw, judged());
