@@ -117,7 +117,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "tuck_time", "open_time", "open_rotation",
           "open_turn",
           "balance_kp",
-          "balance_kd", "balance_max_force", "gravity_compensation", "stance_landing",
+          "balance_kd", "balance_max_force", "crouch_lean", "gravity_compensation", "stance_landing",
           "stand_after", "stand_duration", "level_feet", "landing_reach",
           "landing_at_touchdown"});
   auto c = std::make_shared<JumpControllerConfig>();
@@ -131,6 +131,7 @@ std::shared_ptr<const ControllerConfig> JumpControllerType::read_config(const To
   c->balance_kp = r.number("balance_kp", 0, 10000, c->balance_kp);
   c->balance_kd = r.number("balance_kd", 0, 5000, c->balance_kd);
   c->balance_max_force = r.number("balance_max_force", 0, 5000, c->balance_max_force);
+  c->crouch_lean = r.number("crouch_lean", 0, 1, c->crouch_lean);
   c->gravity_compensation = r.number("gravity_compensation", 0, 2, c->gravity_compensation);
   c->stance_landing = r.boolean("stance_landing", c->stance_landing);
   c->level_feet = r.boolean("level_feet", c->level_feet);
@@ -555,8 +556,13 @@ void JumpController::control(const mjModel* m, mjData* d, const ContactState& co
   if (has_balance(phase_) && contacts.any) {
     const int* feet = body_.feet.data();
     const double support = 0.5 * (d->xipos[3 * feet[0]] + d->xipos[3 * feet[1]]);
-    const double fx = std::clamp(config_.balance_kp * (support + balance_offset_ - com_[0]) -
-                                     config_.balance_kd * com_vel_[0],
+    double target = support + balance_offset_, speed = 0;
+    if (phase_ == kCrouch && config_.crouch_lean > 0) {  // lead the COM along the lean
+      const double duration = std::max(crouch_duration_, 1e-6);
+      target += std::clamp((t - phase_begin_) / duration, 0.0, 1.0) * config_.crouch_lean;
+      speed = config_.crouch_lean / duration;
+    }
+    const double fx = std::clamp(config_.balance_kp * (target - com_[0]) + config_.balance_kd * (speed - com_vel_[0]),
                                  -config_.balance_max_force, config_.balance_max_force);
     const double fz = config_.gravity_compensation * body_.total_mass * gravity_;
     for (int group : {ankle_, knee_, hip_}) {

@@ -88,6 +88,13 @@ struct JumpControllerConfig : ControllerConfig {
   double balance_kp = 1500;          // N/m, horizontal COM servo
   double balance_kd = 300;           // N s/m
   double balance_max_force = 400;    // N, clamp on |F_x|
+  // m; > 0: in the crouch the balance servo leads the COM along a lean instead of holding
+  // it over the feet: its target moves from the feet (plus the balance offset) to this far
+  // ahead of them over the crouch, at the speed that takes (F_x = kp (x_ref - x) +
+  // kd (v_ref - v)), so a crouch that leans in to build a jump's forward speed follows the
+  // same path after a push instead of falling from wherever the push left it; 0: held
+  // over the feet (the paper's).
+  double crouch_lean = 0;
   double gravity_compensation = 1;   // F_z = this * M g during balance
   bool landing_control = true;       // servo the feet during fall
   double landing_height_m = 0;       // m, height of the surface the COM prediction uses

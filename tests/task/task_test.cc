@@ -69,7 +69,7 @@ TEST_F(TaskFileTest, ControllerTypeIsLookedUpAndCheckedAgainstTheCharacter) {
             ": controller.type: expected one of \"jump2d\", \"jump3d\", \"walk3d\", got \"walk9\"");
   EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"jump2d\"\nbounce = 2")),
             ": controller.bounce: expected no such key (unknown key; known keys: type, landing_control, "
-            "landing_height, extend_timeout, tuck_time, open_time, open_rotation, open_turn, balance_kp, balance_kd, balance_max_force, gravity_compensation, "
+            "landing_height, extend_timeout, tuck_time, open_time, open_rotation, open_turn, balance_kp, balance_kd, balance_max_force, crouch_lean, gravity_compensation, "
             "stance_landing, stand_after, stand_duration, level_feet, landing_reach, landing_at_touchdown)");
   const Task planar = load_task(write(valid_text()));
   EXPECT_EQ(planar.controller_type->name(), std::string("jump2d"));
