@@ -24,7 +24,7 @@ namespace {
 std::string variant(const std::string& name, const std::string& lines) {
   return test_files::task_variant("jump_forward", "stance_landing_" + name,
                                   {"stance_landing =", "stand_after =", "stand_duration =", "balance_kp =",
-                                   "balance_kd =", "balance_max_force ="},
+                                   "balance_kd =", "balance_max_force =", "crouch_lean ="},
                                   {{"controller", lines}})
       .string();
 }
