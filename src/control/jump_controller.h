@@ -4,7 +4,8 @@
 // A finite state machine over six phases:
 //
 //   start   stance, balance, ends after start.duration
-//   crouch  stance, ends after crouch.duration
+//   crouch  stance, ends after crouch.duration (with the config's crouch_lean the balance
+//           servo leads the COM along a lean ahead of the feet instead of holding it)
 //   extend  stance, targets applied at once (no interpolation) to build momentum,
 //           ends when the character is airborne (no contact with anything for
 //           airborne_time, COM rising)
