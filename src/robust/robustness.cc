@@ -55,23 +55,20 @@ std::vector<Job> make_jobs(const TaskEvaluator& evaluator, const MotionUnderTest
     jobs.push_back(std::move(job));
   }
   const bool planar = evaluator.body().root == RootKind::kPlanar;
-  const int directions = push_directions(planar);
   const GroundWindows windows = ground_windows(evaluator.task(), base);
   for (int s = 0; s < suite.push_samples; ++s) {
     Rng rng(derive_seed(suite.seed, {index, static_cast<std::uint64_t>(PerturbationKind::kPush),
                                      static_cast<std::uint64_t>(s)}));
-    const PushDirection& dir = push_direction(s, planar);
-    const GroundWindow& w = windows[static_cast<std::size_t>((s / directions + suite.first_push_phase) % 2)];
+    const PushDraw draw = draw_push(windows, s, planar, suite.first_push_phase, rng.uniform(), suite.push_speed);
     Job job;
     job.motion = m;
     job.rollout.kind = PerturbationKind::kPush;
     job.rollout.sample = s;
-    job.rollout.phase = w.phase;
-    job.rollout.direction = dir.name;
+    job.rollout.phase = draw.phase;
+    job.rollout.direction = draw.direction;
     job.parameters = motion.parameters;
     job.options = judged_options();
-    job.options.push.time = w.begin + rng.uniform() * (w.end - w.begin);
-    for (std::size_t k = 0; k < 3; ++k) job.options.push.dv[k] = suite.push_speed * dir.axis[k];
+    job.options.push = draw.push;
     job.rollout.dv = job.options.push.dv;
     jobs.push_back(std::move(job));
   }

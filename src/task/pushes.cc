@@ -39,4 +39,14 @@ const PushDirection& push_direction(int k, bool planar) {
   return kDirections[((k % n) + n) % n];
 }
 
+PushDraw draw_push(const GroundWindows& windows, int k, bool planar, int first_window, double fraction,
+                   double speed) {
+  const PushDirection& d = push_direction(k, planar);
+  const GroundWindow& w = windows[static_cast<std::size_t>((k / push_directions(planar) + first_window) % 2)];
+  PushDraw out{{}, w.phase, d.name};
+  out.push.time = w.begin + fraction * (w.end - w.begin);
+  for (std::size_t a = 0; a < 3; ++a) out.push.dv[a] = speed * d.axis[a];
+  return out;
+}
+
 }  // namespace diverse

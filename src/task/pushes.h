@@ -4,8 +4,7 @@
 // push term (task/seed_motion.h, SeedOptions::pushes).
 //
 //   const GroundWindows w = ground_windows(task, evaluation);
-//   options.push.time = w[0].begin + u * (w[0].end - w[0].begin);   // u in [0, 1)
-//   const PushDirection& d = push_direction(k, planar);             // k-th of a round
+//   options.push = draw_push(w, k, planar, 0, u, 0.3).push;   // push k, u in [0, 1)
 //
 // Ground phases.
 // A jump: [0] from the start to take-off ("takeoff"), [1] from touch-down to touch-down
@@ -39,5 +38,16 @@ struct PushDirection {
 };
 int push_directions(bool planar);                          // 2 or 4
 const PushDirection& push_direction(int k, bool planar);   // k modulo a round
+
+// Push k of a series: its direction by k in turn, its ground phase alternating after
+// every round of directions (window (k / round + first_window) % 2), its moment at
+// `fraction` (in [0, 1)) of that phase, and `speed` (m/s) along the direction.
+struct PushDraw {
+  EvaluationOptions::Push push;
+  const char* phase;      // the window's name
+  const char* direction;  // the direction's name
+};
+PushDraw draw_push(const GroundWindows& windows, int k, bool planar, int first_window, double fraction,
+                   double speed);
 
 }  // namespace diverse

@@ -234,14 +234,9 @@ Scored score(const TaskEvaluator& ev, const TaskEvaluator& fine, const Eigen::Ve
   if (!robust.push_moments.empty()) {
     const GroundWindows windows = ground_windows(ev.task(), e);
     const bool planar = ev.body().root == RootKind::kPlanar;
-    const int round = push_directions(planar);
     for (std::size_t k = 0; k < robust.push_moments.size(); ++k) {
-      const int i = static_cast<int>(k);
-      const GroundWindow& w = windows[static_cast<std::size_t>((i / round) % 2)];
       EvaluationOptions pushed = perturbed;
-      pushed.push.time = w.begin + robust.push_moments[k] * (w.end - w.begin);
-      const PushDirection& d = push_direction(i, planar);
-      for (std::size_t a = 0; a < 3; ++a) pushed.push.dv[a] = robust.push_speed * d.axis[a];
+      pushed.push = draw_push(windows, static_cast<int>(k), planar, 0, robust.push_moments[k], robust.push_speed).push;
       const double c = seed_constraint(ev.evaluate_normalized(x, worker, pushed), ev.task(), seed);
       sum += term(c);
       if (c == 0) ++met;
