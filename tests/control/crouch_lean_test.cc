@@ -1,8 +1,9 @@
 // "jump2d" with crouch_lean (control/jump_controller.h): in the crouch the balance servo
 // leads the COM along a lean instead of holding it over the feet. On jump_forward's input
 // motion (crouch_lean = 0.2): pushed by 0.3 m/s forward or backward at four moments of
-// its crouch, it still lands in its box and stands in 5 of the eight rollouts (every
-// forward push; backward ones early in the crouch still land short), where the input
+// its crouch, it still lands in its box and stands in 6 of the eight rollouts (measured:
+// the forward pushes but the latest, which lands 4 cm past the box, and the backward
+// ones but the earliest, which lands short and falls), where the input
 // motion found before it without the lean (tests/control/data/jump_forward.no_lean.m0.json,
 // under the task without the key) holds none, and its take-off speed stays nearer its own
 // unpushed one. Bad values are refused.
