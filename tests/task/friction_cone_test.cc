@@ -37,8 +37,11 @@ TEST(FrictionCone, ThePlanarHumanHasTheEllipticCone) {
   EXPECT_EQ(TaskEvaluator(pyramidal).model().get()->opt.timestep, TaskEvaluator(task).model().get()->opt.timestep);
 }
 
+// The high jump's input motion found under the default balance servo
+// (tests/task/data/jump_high_default_servo.toml), found under the elliptic cone from the
+// one found under the pyramidal cone.
 TEST(FrictionCone, AFloorOfOtherFrictionLeavesAPushOffThatDoesNotSlideAlone) {
-  const Task elliptic = load_task(kTasks + "jump_high.toml");
+  const Task elliptic = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_high_default_servo.toml");
   Task pyramidal = elliptic;
   pyramidal.simulation.friction_cone = "pyramidal";
   const double deg = 180 / M_PI;

@@ -228,9 +228,10 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
   // before, bit for bit; one that is ended still misses it, with its landing terms and a
   // fall at the end of the motion (the term "ended_decided"). Most such landings do fall
   // later, so that C puts more pairs of samples in the full rollout's order than the same
-  // C without the fall would.
+  // C without the fall would (around the high jump's input motion found under the
+  // default balance servo, tests/task/data/jump_high_default_servo.toml).
   {
-    const Task task = load_task(kTasks + "jump_high.toml");
+    const Task task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_high_default_servo.toml");
     const TaskEvaluator ev(task);
     const ParameterSet m0 = ev.load_parameters(task.m0);
     auto worker = ev.make_worker();

@@ -74,12 +74,13 @@ TEST(SoleMargin, IsTheDistanceToTheHullOfTheSolesIn3d) {
   EXPECT_NEAR(s.margin(cx, outer + 0.2), -0.2, 1e-3);  // 20 cm beside the outer edge
 }
 
-// Around the high jump's input motion (the steps the optimizer takes early on): with the
-// rule, exactly the same perturbations meet the task with the same C, every one that
-// fell still falls and none that stood does, most falls end as topples, and those end
+// Around the high jump's input motion found under the default balance servo
+// (tests/task/data/jump_high_default_servo.toml; the steps the optimizer takes early on):
+// with the rule, exactly the same perturbations meet the task with the same C, every one
+// that fell still falls and none that stood does, most falls end as topples, and those end
 // sooner.
 TEST(Topple, EndsTheHighJumpsTopplesSoonerAndChangesNoOtherOutcome) {
-  Task without = load_task(kTasks + "jump_high.toml");
+  Task without = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tests/task/data/jump_high_default_servo.toml");
   without.simulation.topple_distance = 0;
   Task with = without;
   with.simulation.topple_distance = 0.05;
