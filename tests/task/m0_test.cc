@@ -352,7 +352,7 @@ TEST(M0Specifics, JumpBackwardsMeetsItsTaskUnderConstrainedDamping) {
 
 // The backwards jump's input motion of today runs under constrained damping, and its
 // neighbourhood is wider than the earlier one's under MuJoCo's damping: of 32
-// perturbations at sigma 0.02 (both sides apart, judged at both timesteps) 19 meet the
+// perturbations at sigma 0.02 (both sides apart, judged at both timesteps) 18 meet the
 // task against 2.
 TEST(M0Specifics, JumpBackwardsNeighbourhoodWiderThanUnderMujocoDamping) {
   REQUIRE_M0("jump_backwards");
