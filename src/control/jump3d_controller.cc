@@ -161,7 +161,7 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_hei
 
 std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const TomlReader& r) const {
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd", "asymmetric", "yaw_kp",
-          "yaw_kd", "neck_attitude_kp", "neck_attitude_kd", "land_swing_placement"});
+          "yaw_kd", "neck_attitude_kp", "neck_attitude_kd", "land_swing_placement", "joint_space_extend"});
   auto c = std::make_shared<Jump3dControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -174,6 +174,7 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const 
   c->neck_attitude_kp = r.number("neck_attitude_kp", 0, 10, c->neck_attitude_kp);
   c->neck_attitude_kd = r.number("neck_attitude_kd", 0, 2, c->neck_attitude_kd);
   c->land_swing_placement = r.boolean("land_swing_placement", c->land_swing_placement);
+  c->joint_space_extend = r.boolean("joint_space_extend", c->joint_space_extend);
   return c;
 }
 
@@ -636,6 +637,31 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   const double s = phase_duration_ > 0 ? std::clamp((t - phase_begin_) / phase_duration_, 0.0, 1.0) : 1.0;
   const size_t n = body_.joints.size();
 
+  if (phase_ == kExtend && config_.joint_space_extend) {
+    // Joint-space push-off: targets set once, at the extend's first step.
+    if (phase_changed_) {
+      for (size_t k = 0; k < n; ++k) {
+        const int g = body_.joints[k].group;
+        const int slot = pose_slot_[static_cast<size_t>(g)];
+        if (slot < 0) target_[k] = qpos0_[k];
+        else if (g == hip_ || g == foot_group_ || g == chest_)
+          target_[k] = clamp_to_range(body_.joints[k], qpos0_[k] + pose_[kExtend][static_cast<size_t>(slot)][static_cast<size_t>(side_[k])]);
+        else target_[k] = pose_[kExtend][static_cast<size_t>(slot)][static_cast<size_t>(side_[k])];
+      }
+    }
+    const auto& kp = kp_[kExtend];
+    const auto& kd = kd_[kExtend];
+    for (size_t k = 0; k < n; ++k) {
+      const CharacterJoint& j = body_.joints[k];
+      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
+      const int gs = j.group == foot_group_ ? 2 : gain_slot_[static_cast<size_t>(j.group)];
+      const size_t side = static_cast<size_t>(side_[k]);
+      const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)][side] : g.kp);
+      const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)][side] : g.kd);
+      drive.set(static_cast<int>(k), p * (target_[k] - d->qpos[j.qpos]), v);
+    }
+    return;
+  }
   if (is_stance(phase_)) {
     for (size_t k = 0; k < n; ++k) target_[k] = from_.joints[k] + s * (goal_.joints[k] - from_.joints[k]);
     if (phase_ == kLand && config_.land_swing_placement && !(contacts.foot[0] && contacts.foot[1]))

@@ -80,6 +80,16 @@
 //           would swing back and up: beside the foot still on the ground, moved along the
 //           heading toward the COM's capture point x + v sqrt(z / g) by at most 0.2 m; with
 //           both feet off, under the capture point.
+//   joint_space_extend (true/false)  the extend is joint-space PD, as the flight phases
+//           are, instead of stance control: every joint toward a target with the extend's
+//           gains (the foot's joints with the ankles'; groups without a parameter toward
+//           the standing pose), the hip, foot and chest values of the extend read as joint
+//           angles relative to the standing pose (qpos0) and every other value as a joint
+//           angle. Stance control's torques switch with the contacts (a leg is a stance
+//           leg, pushing by J^T, only while its foot touches the ground, and the feet track
+//           world pitches), so a push-off on the feet's front corners branched on which
+//           corner touched at which step; PD torques depend on the joints' state alone
+//           (docs/jumps3d.md, "A push-off in joint space").
 //
 // No external force is ever applied: the root is unactuated and every torque goes through
 // the joint drive (physics/drive.h), which keeps it within the joint's limit on the net
@@ -133,6 +143,8 @@ struct Jump3dControllerConfig : ControllerConfig {
   double neck_attitude_kp = 0, neck_attitude_kd = 0;
   // in land, a leg whose foot is off the ground points at the COM's capture point
   bool land_swing_placement = false;
+  // the extend drives every joint by PD toward joint-space targets (no stance control)
+  bool joint_space_extend = false;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
