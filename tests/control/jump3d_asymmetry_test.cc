@@ -41,11 +41,13 @@ std::string read(const std::string& path) {
 }
 
 // tasks/NAME.toml with absolute paths, its `asymmetric = true` line replaced by `line`, and
-// under MuJoCo's damping, under which the input motions kept here were found (a task file
-// that asks for `damping = "constrained"` has that line dropped).
+// under MuJoCo's damping and stance control's push-off, under which the input motions kept
+// here were found (a task file that asks for `damping = "constrained"` or
+// `joint_space_extend = true` has that line dropped).
 std::string task_variant(const std::string& name, const std::string& line) {
   std::string t = read(kRoot + "/tasks/" + name + ".toml");
   t = std::regex_replace(t, std::regex("\ndamping = \"constrained\""), "\n");
+  t = std::regex_replace(t, std::regex("\njoint_space_extend = true"), "\n");
   t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + kRoot + "/assets/");
   t = std::regex_replace(t, std::regex("m0 = \""), "m0 = \"" + kRoot + "/tasks/");
   t = std::regex_replace(t, std::regex("base = \""), "base = \"" + kRoot + "/tasks/");
@@ -64,7 +66,7 @@ Task symmetric_task(const std::string& name) { return load_task(task_variant(nam
 Task asymmetric_task(const std::string& name) { return load_task(task_variant(name, "asymmetric = true")); }
 std::string old_m0(const std::string& name) { return kData + name + ".m0.symmetric.json"; }
 // The input motion as first converted for the split controller (each side the shared
-// value): the task's m0 until a search of its own replaced it; robot_jump's still is.
+// value): the task's m0 until a search of its own replaced it.
 std::string converted_m0(const std::string& name, const Task& task) {
   const std::string kept = kData + name + ".m0.converted.json";
   return std::filesystem::exists(kept) ? kept : task.m0;

@@ -46,7 +46,7 @@ Spread spread(const Task& task, double sigma, int samples) {
 }
 
 TEST(Jump3dJointSpaceExtend, IsOffByDefault) {
-  const Task t = load_task(kRoot + "/tasks/robot_jump.toml");
+  const Task t = load_task(kRoot + "/tasks/jump_backwards.toml");
   EXPECT_FALSE(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config).joint_space_extend);
 }
 
@@ -73,6 +73,7 @@ TEST(Jump3dJointSpaceExtend, PerturbedJumpsLandAtBothTimestepsNearerEachOther) {
   auto c = std::make_shared<Jump3dControllerConfig>(
       dynamic_cast<const Jump3dControllerConfig&>(*stance_task.controller_config));
   c->asymmetric = false;
+  c->joint_space_extend = false;
   stance_task.controller_config = c;
   stance_task.m0 = kRoot + "/tests/control/data/robot_jump.m0.symmetric.json";
   const Spread stance = spread(stance_task, 0.005, 16);

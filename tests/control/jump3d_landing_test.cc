@@ -24,13 +24,16 @@ namespace {
 
 const std::string kRoot = DIVERSE_SOURCE_DIR;
 
-// The robot's jump task with its controller's options changed by `edit`.
+// The robot's jump task with its controller's options changed by `edit`, pushing off by
+// stance control, and its input motion of then (tests/control/data/robot_jump.m0.converted.json).
 template <typename Edit>
 Task robot_jump_with(Edit edit) {
   Task t = load_task(kRoot + "/tasks/robot_jump.toml");
+  t.m0 = kRoot + "/tests/control/data/robot_jump.m0.converted.json";
   auto c = std::make_shared<Jump3dControllerConfig>(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config));
   c->yaw_kp = c->yaw_kd = c->neck_attitude_kp = c->neck_attitude_kd = 0;
   c->land_swing_placement = false;
+  c->joint_space_extend = false;
   edit(*c);
   t.controller_config = c;
   return t;

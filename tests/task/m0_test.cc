@@ -81,10 +81,11 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     {"jump_over", {0.01, 32, 18}},
     {"jump_high", {0.02, 32, 20}},
     // The 3D jumps: perturbed on both sides apart (their tasks' `asymmetric = true`) and
-    // judged at half the timestep too; robot_jump's M0 has no such neighbour that meets
-    // its task (0 of 32 at sigma 0.005, docs/jumps3d.md), so it has no bound here;
-    // jump_backwards' measures 18 at 0.02.
-    {"jump_backwards", {0.02, 32, 16}}};
+    // judged at half the timestep too; jump_backwards' measures 18 at 0.02, robot_jump's
+    // (pushed off in joint space) 4 at 0.005, where the one before it had none
+    // (docs/jumps3d.md, "A push-off in joint space").
+    {"jump_backwards", {0.02, 32, 16}},
+    {"robot_jump", {0.005, 32, 3}}};
 
 TEST_P(M0, MeetsItsTask) {
   REQUIRE_M0(GetParam());
