@@ -418,6 +418,20 @@ void Jump3dController::enter(int phase, const mjModel* m, const mjData* d) {
   const size_t n = body_.joints.size();
   const std::vector<Sides>& pose = pose_[static_cast<size_t>(phase)];
 
+  if (phase == kExtend && config_.joint_space_extend) {
+    // A push-off in joint space: every target at once, the hip, foot and chest values as
+    // joint angles from the standing pose.
+    for (size_t k = 0; k < n; ++k) {
+      const int g = body_.joints[k].group;
+      const int slot = pose_slot_[static_cast<size_t>(g)];
+      const double value = slot >= 0 ? pose[static_cast<size_t>(slot)][static_cast<size_t>(side_[k])] : 0.0;
+      if (slot < 0) target_[k] = qpos0_[k];
+      else if (g == hip_ || g == foot_group_ || g == chest_) target_[k] = clamp_to_range(body_.joints[k], qpos0_[k] + value);
+      else target_[k] = value;
+    }
+    phase_duration_ = 0;
+    return;
+  }
   if (is_stance(phase)) {
     if (phase == kLand) stance_->reset(m, d);  // the heading and footing it landed with
     // Start from where the body is (after reset or flight) or from the targets commanded
@@ -638,28 +652,7 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   const size_t n = body_.joints.size();
 
   if (phase_ == kExtend && config_.joint_space_extend) {
-    // Joint-space push-off: targets set once, at the extend's first step.
-    if (phase_changed_) {
-      for (size_t k = 0; k < n; ++k) {
-        const int g = body_.joints[k].group;
-        const int slot = pose_slot_[static_cast<size_t>(g)];
-        if (slot < 0) target_[k] = qpos0_[k];
-        else if (g == hip_ || g == foot_group_ || g == chest_)
-          target_[k] = clamp_to_range(body_.joints[k], qpos0_[k] + pose_[kExtend][static_cast<size_t>(slot)][static_cast<size_t>(side_[k])]);
-        else target_[k] = pose_[kExtend][static_cast<size_t>(slot)][static_cast<size_t>(side_[k])];
-      }
-    }
-    const auto& kp = kp_[kExtend];
-    const auto& kd = kd_[kExtend];
-    for (size_t k = 0; k < n; ++k) {
-      const CharacterJoint& j = body_.joints[k];
-      const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
-      const int gs = j.group == foot_group_ ? 2 : gain_slot_[static_cast<size_t>(j.group)];
-      const size_t side = static_cast<size_t>(side_[k]);
-      const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)][side] : g.kp);
-      const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)][side] : g.kd);
-      drive.set(static_cast<int>(k), p * (target_[k] - d->qpos[j.qpos]), v);
-    }
+    drive_toward_targets(d, drive, /*foot_with_ankle_gains=*/true);  // the targets enter() set
     return;
   }
   if (is_stance(phase_)) {
@@ -709,12 +702,16 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
     }
   }
   if (neck_ >= 0 && (config_.neck_attitude_kp > 0 || config_.neck_attitude_kd > 0)) turn_head_toward_landing(d);
+  drive_toward_targets(d, drive, /*foot_with_ankle_gains=*/false);
+}
+
+void Jump3dController::drive_toward_targets(const mjData* d, JointDrive& drive, bool foot_with_ankle_gains) const {
   const auto& kp = kp_[static_cast<size_t>(phase_)];
   const auto& kd = kd_[static_cast<size_t>(phase_)];
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < body_.joints.size(); ++k) {
     const CharacterJoint& j = body_.joints[k];
     const JointGroup& g = body_.groups[static_cast<size_t>(j.group)];
-    const int gs = gain_slot_[static_cast<size_t>(j.group)];
+    const int gs = foot_with_ankle_gains && j.group == foot_group_ ? 2 : gain_slot_[static_cast<size_t>(j.group)];
     const size_t side = static_cast<size_t>(side_[k]);
     const double p = body_.strength * (gs >= 0 ? kp[static_cast<size_t>(gs)][side] : g.kp);
     const double v = body_.strength * (gs >= 0 ? kd[static_cast<size_t>(gs)][side] : g.kd);

@@ -219,6 +219,9 @@ class Jump3dController : public Controller {
   void place_lifted_legs(const mjData* d, const ContactState& contacts);
   // neck_attitude_kp, kd: the sagittal neck's flight target from the root's pitch (target_).
   void turn_head_toward_landing(const mjData* d);
+  // PD toward target_ with the phase's gains (the character's for groups without any);
+  // `foot_with_ankle_gains`: the foot group's joints take the ankles' (joint_space_extend).
+  void drive_toward_targets(const mjData* d, JointDrive& drive, bool foot_with_ankle_gains) const;
 
   const Character& body_;
   Jump3dControllerConfig config_;
