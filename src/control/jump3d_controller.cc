@@ -161,7 +161,8 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_hei
 
 std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const TomlReader& r) const {
   r.only({"type", "landing_control", "landing_height", "extend_timeout", "com_kp", "com_kd", "asymmetric", "yaw_kp",
-          "yaw_kd", "neck_attitude_kp", "neck_attitude_kd", "land_swing_placement", "joint_space_extend"});
+          "yaw_kd", "neck_attitude_kp", "neck_attitude_kd", "land_swing_placement", "joint_space_extend",
+          "extend_root_kd"});
   auto c = std::make_shared<Jump3dControllerConfig>();
   c->landing_control = r.boolean("landing_control", c->landing_control);
   c->landing_height_m = r.number("landing_height", 0, 3, c->landing_height_m);
@@ -175,6 +176,8 @@ std::shared_ptr<const ControllerConfig> Jump3dControllerType::read_config(const 
   c->neck_attitude_kd = r.number("neck_attitude_kd", 0, 2, c->neck_attitude_kd);
   c->land_swing_placement = r.boolean("land_swing_placement", c->land_swing_placement);
   c->joint_space_extend = r.boolean("joint_space_extend", c->joint_space_extend);
+  c->extend_root_kd = r.number("extend_root_kd", 0, 5000, c->extend_root_kd);
+  if (c->extend_root_kd > 0 && !c->joint_space_extend) r.fail("extend_root_kd", "expected joint_space_extend = true with it");
   return c;
 }
 
@@ -653,6 +656,7 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
 
   if (phase_ == kExtend && config_.joint_space_extend) {
     drive_toward_targets(d, drive, /*foot_with_ankle_gains=*/true);  // the targets enter() set
+    if (config_.extend_root_kd > 0) damp_root_with_hips(d, drive);
     return;
   }
   if (is_stance(phase_)) {
@@ -703,6 +707,20 @@ void Jump3dController::control(const mjModel* m, mjData* d, const ContactState& 
   }
   if (neck_ >= 0 && (config_.neck_attitude_kp > 0 || config_.neck_attitude_kd > 0)) turn_head_toward_landing(d);
   drive_toward_targets(d, drive, /*foot_with_ankle_gains=*/false);
+}
+
+void Jump3dController::damp_root_with_hips(const mjData* d, JointDrive& drive) const {
+  // Each hip hinge turns the root the other way about its axis; the two legs' hinges
+  // together give the root -extend_root_kd times its angular velocity about each axis.
+  const double* w = d->cvel + 6 * body_.root_body;
+  for (const LegGeometry& leg : legs_) {
+    for (int k : {leg.hip_pitch, leg.hip_roll}) {
+      if (k < 0) continue;
+      const double* a = d->xaxis + 3 * body_.joints[static_cast<size_t>(k)].joint;
+      const double rate = a[0] * w[0] + a[1] * w[1] + a[2] * w[2];
+      drive.set(k, drive.u(k) + 0.5 * config_.extend_root_kd * body_.strength * rate, drive.kd(k));
+    }
+  }
 }
 
 void Jump3dController::drive_toward_targets(const mjData* d, JointDrive& drive, bool foot_with_ankle_gains) const {

@@ -90,6 +90,13 @@
 //           world pitches), so a push-off on the feet's front corners branched on which
 //           corner touched at which step; PD torques depend on the joints' state alone
 //           (docs/jumps3d.md, "A push-off in joint space").
+//   extend_root_kd (Nm s/rad; 0 to 5000; with joint_space_extend)  in that extend the hips
+//           also damp the root's rotation: each hip hinge adds kd / 2 times the root's
+//           angular velocity about the hinge's axis, so the root feels -kd w about the
+//           hips' pitch and roll axes, as SIMBICON's stance hip holds the torso. It acts on
+//           the body's state alone, whichever feet touch, and takes out most of the spread
+//           of the angular momentum a perturbed push-off leaves the flight with
+//           (docs/jumps3d.md, "Damping the body's turn in the push-off").
 //
 // No external force is ever applied: the root is unactuated and every torque goes through
 // the joint drive (physics/drive.h), which keeps it within the joint's limit on the net
@@ -145,6 +152,9 @@ struct Jump3dControllerConfig : ControllerConfig {
   bool land_swing_placement = false;
   // the extend drives every joint by PD toward joint-space targets (no stance control)
   bool joint_space_extend = false;
+  // Nm s/rad: with joint_space_extend, the hips damp the root's rotation in the extend
+  // (0: not damped)
+  double extend_root_kd = 0;
 
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
@@ -221,6 +231,8 @@ class Jump3dController : public Controller {
   void turn_head_toward_landing(const mjData* d);
   // PD toward target_ with the phase's gains (the character's for groups without any);
   // `foot_with_ankle_gains`: the foot group's joints take the ankles' (joint_space_extend).
+  // extend_root_kd: adds to each hip hinge's request the damping of the root's rotation
+  void damp_root_with_hips(const mjData* d, JointDrive& drive) const;
   void drive_toward_targets(const mjData* d, JointDrive& drive, bool foot_with_ankle_gains) const;
 
   const Character& body_;

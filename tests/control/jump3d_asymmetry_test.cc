@@ -42,12 +42,13 @@ std::string read(const std::string& path) {
 
 // tasks/NAME.toml with absolute paths, its `asymmetric = true` line replaced by `line`, and
 // under MuJoCo's damping and stance control's push-off, under which the input motions kept
-// here were found (a task file that asks for `damping = "constrained"` or
-// `joint_space_extend = true` has that line dropped).
+// here were found (a task file that asks for `damping = "constrained"`,
+// `joint_space_extend = true` or `extend_root_kd` has that line dropped).
 std::string task_variant(const std::string& name, const std::string& line) {
   std::string t = read(kRoot + "/tasks/" + name + ".toml");
   t = std::regex_replace(t, std::regex("\ndamping = \"constrained\""), "\n");
   t = std::regex_replace(t, std::regex("\njoint_space_extend = true"), "\n");
+  t = std::regex_replace(t, std::regex("\nextend_root_kd = [0-9.]+"), "\n");
   t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + kRoot + "/assets/");
   t = std::regex_replace(t, std::regex("m0 = \""), "m0 = \"" + kRoot + "/tasks/");
   t = std::regex_replace(t, std::regex("base = \""), "base = \"" + kRoot + "/tasks/");

@@ -107,7 +107,7 @@ TEST(Jump3dController, ReadsItsOwnKeysStrictly) {
     EXPECT_EQ(std::string(e.what()), path + ": controller.bounce: expected no such key (unknown key; known keys: "
                                             "type, landing_control, landing_height, extend_timeout, com_kp, com_kd, "
                                             "asymmetric, yaw_kp, yaw_kd, neck_attitude_kp, neck_attitude_kd, "
-                                            "land_swing_placement, joint_space_extend)");
+                                            "land_swing_placement, joint_space_extend, extend_root_kd)");
   }
 }
 
