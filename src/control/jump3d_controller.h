@@ -231,9 +231,10 @@ class Jump3dController : public Controller {
   void turn_head_toward_landing(const mjData* d);
   // PD toward target_ with the phase's gains (the character's for groups without any);
   // `foot_with_ankle_gains`: the foot group's joints take the ankles' (joint_space_extend).
-  // extend_root_kd: adds to each hip hinge's request the damping of the root's rotation
-  void damp_root_with_hips(const mjData* d, JointDrive& drive) const;
   void drive_toward_targets(const mjData* d, JointDrive& drive, bool foot_with_ankle_gains) const;
+  // extend_root_kd: adds to each hip hinge's request (after drive_toward_targets) the
+  // damping of the root's rotation about the hinge's axis.
+  void damp_root_with_hips(const mjData* d, JointDrive& drive) const;
 
   const Character& body_;
   Jump3dControllerConfig config_;
