@@ -64,9 +64,14 @@ set_target_properties(diverse_core PROPERTIES EXPORT_NAME core POSITION_INDEPEND
 target_include_directories(diverse_core PUBLIC
   $<BUILD_INTERFACE:${DIVERSE_ROOT}/src> $<INSTALL_INTERFACE:include/diverse>)
 target_compile_options(diverse_core PRIVATE ${DIVERSE_WARNINGS})
-target_compile_definitions(diverse_core
-  PUBLIC $<BUILD_INTERFACE:DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}">
-  PRIVATE DIVERSE_VERSION="${DIVERSE_VERSION_STRING}")
+target_compile_definitions(diverse_core PRIVATE DIVERSE_VERSION="${DIVERSE_VERSION_STRING}")
+# The source tree's path, for the two library files that look there (the built-in tasks, the
+# gallery page's sources) and for tests, benchmarks and fuzz targets (diverse_source_dir). Only
+# where it is read, so that the rest of the library compiles the same from any checkout.
+set_property(SOURCE ${DIVERSE_ROOT}/src/task/task.cc ${DIVERSE_ROOT}/src/render/gallery.cc
+  APPEND PROPERTY COMPILE_DEFINITIONS DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}")
+add_library(diverse_source_dir INTERFACE)
+target_compile_definitions(diverse_source_dir INTERFACE DIVERSE_SOURCE_DIR="${DIVERSE_ROOT}")
 target_link_libraries(diverse_core PUBLIC
   Eigen3::Eigen diverse_mujoco tomlplusplus::tomlplusplus
   nlohmann_json::nlohmann_json Threads::Threads PNG::PNG ${OSMESA_LIBRARY})
