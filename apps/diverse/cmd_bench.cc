@@ -47,6 +47,9 @@ void install_bench(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("bench", "Measure rollout throughput against raw mj_step");
+  cmd->footer("Examples:\n"
+              "  diverse bench jump_high --threads 2 --rounds 7\n"
+              "  diverse bench --character assets/characters/robot3d.toml");
   cmd->add_option("task", args->task, "Task name or path")->capture_default_str();
   cmd->add_option("--seconds", args->seconds, "Seconds per measurement in each round")
       ->capture_default_str()

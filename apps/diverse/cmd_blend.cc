@@ -30,6 +30,8 @@ struct BlendArgs {
 void install(CLI::App& app) {
   auto args = std::make_shared<BlendArgs>();
   CLI::App* cmd = app.add_subcommand("blend", "Simulate convex combinations of a finished run's controllers");
+  cmd->footer("Example:\n"
+              "  diverse blend runs/jump_high --samples 64");
   cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
   cmd->add_option("--samples", args->samples, "Blends K, weights drawn uniformly on the simplex of M0..MN")
       ->check(integer_in(1, 100000))

@@ -30,6 +30,9 @@ std::string range_text(const CharacterJoint& j) {
 void install_character(CLI::App& app) {
   auto file = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand("character", "Load and validate a character, and describe it");
+  cmd->footer("Examples:\n"
+              "  diverse character assets/characters/robot3d.toml\n"
+              "  diverse character examples/own-character/tailwalker.toml");
   cmd->add_option("file", *file, "Character file (.toml), or an MJCF with its character file beside it")
       ->required();
   cmd->callback([file] {

@@ -132,6 +132,8 @@ void add_cmaes(CLI::App& app) {
   auto args = std::make_shared<CmaesArgs>();
   CLI::App* sub = app.add_subcommand(
       "cmaes", "Run CMA-ES on a test function and print the result as one JSON object");
+  sub->footer("Example:\n"
+              "  diverse cmaes --function rosenbrock --dim 10 --seed 3");
   sub->add_option("--function", args->function,
                   "Test function: sphere, ellipsoid, rosenbrock or rastrigin")
       ->required();

@@ -30,6 +30,8 @@ struct ExportArgs {
 void install(CLI::App& app) {
   auto args = std::make_shared<ExportArgs>();
   CLI::App* cmd = app.add_subcommand("export", "Export a finished run's motions for animation tools");
+  cmd->footer("Example:\n"
+              "  diverse export runs/jump_high --bvh --gltf");
   cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
   cmd->add_flag("--bvh", args->bvh, "BVH files (RUN/export/m<i>.bvh), metres, Y up");
   cmd->add_flag("--gltf", args->gltf,

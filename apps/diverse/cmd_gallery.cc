@@ -28,6 +28,8 @@ struct GalleryArgs {
 void install(CLI::App& app) {
   auto args = std::make_shared<GalleryArgs>();
   CLI::App* cmd = app.add_subcommand("gallery", "Interactive 3D gallery of a finished run (one HTML file)");
+  cmd->footer("Example:\n"
+              "  diverse gallery runs/jump_high       # writes runs/jump_high/gallery.html");
   cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
   cmd->add_flag("--no-paths", args->no_paths,
                 "Leave out the optimization paths (they are simulated from the run's task file)");

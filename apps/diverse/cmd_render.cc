@@ -26,6 +26,8 @@ struct RenderArgs {
 void install(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Film strip and videos of a finished run");
+  cmd->footer("Example:\n"
+              "  diverse render runs/jump_high --half-speed");
   cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
   cmd->add_flag("--half-speed", args->half_speed, "Videos at half speed");
   cmd->add_flag("--no-video", args->no_video, "Only the film strip");

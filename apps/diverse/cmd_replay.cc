@@ -152,6 +152,8 @@ void install(CLI::App& app) {
   auto task = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "replay", "Replay a motion record in plain MuJoCo, compare qpos and check net joint torques");
+  cmd->footer("Example:\n"
+              "  diverse replay runs/jump_high/motions/m1.json");
   cmd->add_option("motion", *path, "motion.json written by simulate or run")->required();
   cmd->add_option("--task", *task,
                   "Task file whose [walk] rules a walk is audited against (default: the run's, else tasks/<task>.toml)");

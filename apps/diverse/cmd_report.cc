@@ -30,6 +30,8 @@ std::string format(const char* fmt, double v) {
 void install_report(CLI::App& app) {
   auto runs = std::make_shared<std::vector<std::string>>();
   CLI::App* cmd = app.add_subcommand("report", "A Markdown table of finished runs");
+  cmd->footer("Example:\n"
+              "  diverse report runs/jump_high runs/backflip");
   cmd->add_option("runs", *runs, "Run directories")->required();
   cmd->callback([runs] {
     // Every directory is checked before the table starts, so an error is the only output.

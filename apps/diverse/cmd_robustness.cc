@@ -194,6 +194,9 @@ void install(CLI::App& app) {
   auto args = std::make_shared<RobustnessArgs>();
   CLI::App* cmd = app.add_subcommand(
       "robustness", "The share of perturbed rollouts of a motion (or of a run's motions) that still meet the task");
+  cmd->footer("Examples:\n"
+              "  diverse robustness runs/jump_high    # every motion of a finished run\n"
+              "  diverse robustness --task backflip   # a task's input motion");
   cmd->add_option("motion", args->target,
                   "A motion file, a run directory, or a parameter file of --task (default: --task's M0)");
   cmd->add_option("--task", args->task, "Task name or file (for a parameter file, or the task's M0)");

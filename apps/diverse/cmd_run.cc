@@ -68,6 +68,10 @@ void install_run(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
       "run", "Find N diverse variations of a task's input motion (default task: jump_high)");
+  cmd->footer("Examples:\n"
+              "  diverse run                          # 4 diverse high jumps into runs/jump_high/\n"
+              "  diverse run backflip --seed 2        # another task and seed\n"
+              "  diverse run jump_forward --vary shape --metric shape  # body shapes");
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or path to a task file")
       ->capture_default_str();
   cmd->add_option("--n", args->n, "Number of variations N (default: the task's, 4)")
@@ -202,6 +206,8 @@ void install_resume(CLI::App& app) {
   auto no_render = std::make_shared<bool>(false);
   auto rank_timeout = std::make_shared<double>(kDefaultRankTimeoutSeconds);
   CLI::App* cmd = app.add_subcommand("resume", "Continue an interrupted run from its checkpoint");
+  cmd->footer("Example:\n"
+              "  diverse resume runs/jump_high        # the same result as a run never stopped");
   cmd->add_option("dir", *dir, "Run directory")->required();
   cmd->add_option("--threads", *threads, "Worker threads (0 = one per core)")
       ->capture_default_str()

@@ -297,6 +297,9 @@ void install(CLI::App& app) {
   auto args = std::make_shared<SeedArgs>();
   CLI::App* cmd = app.add_subcommand(
       "seed-motion", "Find a task's input motion M0 by CMA-ES on its constraint penalty");
+  cmd->footer("Examples:\n"
+              "  diverse seed-motion jump_forward --generations 100 --out m0.json\n"
+              "  diverse seed-motion backflip --robustness-check --convergence");
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or task file")->required();
   cmd->add_option("--start", args->start, "Starting parameters (default: the task's seed.base)");
   cmd->add_option("--out", args->out, "Output file (default: the task's m0 file)");

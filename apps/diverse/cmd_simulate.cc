@@ -116,6 +116,8 @@ void run(const SimulateArgs& args) {
 void install(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulate a task's motion and write a replayable record");
+  cmd->footer("Example:\n"
+              "  diverse simulate backflip --out runs/backflip-m0");
   cmd->add_option("task", args->task, "Task name (tasks/<name>.toml) or task file")->required();
   cmd->add_option("--params", args->params, "Parameter file (default: the task's M0)");
   cmd->add_option("--out", args->out, "Output directory")->required();

@@ -208,6 +208,9 @@ void add_toy(CLI::App& app) {
   auto args = std::make_shared<ToyArgs>();
   CLI::App* cmd = app.add_subcommand(
       "toy", "Diversity optimization of points in a 2-D region (paper figure 2)");
+  cmd->footer("Examples:\n"
+              "  diverse toy --out runs/toy           # N = 4 points, K = 10\n"
+              "  diverse toy --out runs/toy-k0 --k 0 --seeds 10");
   cmd->add_option("--k", args->k, "weight K of the dmin term (>= 0)")
       ->capture_default_str()
       ->check(number_in(0, 1e9));

@@ -58,6 +58,9 @@ bool reports_errors() {
 int main(int argc, char** argv) {
   CLI::App app{"diverse: diverse motions and character shapes for simulated skills"};
   app.set_version_flag("--version", std::string(DIVERSE_VERSION));
+  app.footer("Examples:\n"
+             "  diverse run                          # 4 diverse high jumps into runs/jump_high/\n"
+             "  diverse run --help                   # a subcommand's options and an example");
   app.require_subcommand(1);
   // A flag given twice takes its last value, as in most command-line tools.
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
