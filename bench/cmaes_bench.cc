@@ -1,6 +1,6 @@
 // Per-generation overhead of the CMA-ES (ask + tell, no objective cost) at n = 100,
 // lambda = 16, with and without the active update, beside an eager Eigen
-// eigendecomposition of the same size. Reference figures on one core (docs/cmaes.md):
+// eigendecomposition of the same size. Reference figures on one core (docs/reference/cmaes.md):
 // pycma 1.15 ms; libcmaes 0.93 ms (0.52 ms with lazy eigendecomposition), active
 // 1.77 ms (1.36 ms lazy).
 #include <benchmark/benchmark.h>

@@ -1,7 +1,7 @@
 // Offscreen rendering cost (OSMesa, llvmpipe, no GPU): milliseconds per 240x240 picture of
 // the planar human (assets/characters/human2d.xml) in a jump pose, with the default style
 // (2x supersampling, shadows) and with each of those turned off, plus the one-off cost of
-// creating a renderer (GL context, MuJoCo's GL resources). docs/rendering.md lists
+// creating a renderer (GL context, MuJoCo's GL resources). docs/guide/rendering.md lists
 // measured values.
 //
 //   diverse_bench --benchmark_filter=Render

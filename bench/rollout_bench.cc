@@ -1,7 +1,7 @@
 // Rollout cost: simulated steps per second of a full task rollout (controller, contact
 // scan, constraint monitor) without and with the step recorder, beside raw mj_step on the
 // same model with zero ctrl. The rollout's "steps_per_s" counter is the figure to compare;
-// docs/character-and-controller.md lists measured values.
+// docs/reference/controllers.md lists measured values.
 //
 //   diverse_bench --benchmark_filter='Rollout|RawStep'
 #include <benchmark/benchmark.h>

@@ -2,7 +2,7 @@
 // scene's MJCF for a random shape, compiling it (mj_loadXML from memory), and the per-sample
 // setup a worker needs (character map, private model copy and mjData), against one
 // backflip rollout of M0 on the base model. BM_ShapeBuild reports "rollout_fraction", its
-// CPU time over the rollout's (goal: < 0.1); docs/shapes.md lists measured values.
+// CPU time over the rollout's (goal: < 0.1); docs/guide/shapes.md lists measured values.
 //
 //   diverse_bench --benchmark_filter='Shape|BackflipRollout'
 #include <benchmark/benchmark.h>

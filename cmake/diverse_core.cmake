@@ -17,7 +17,7 @@ find_package(Threads REQUIRED)
 find_package(PNG REQUIRED)
 # glTF export (src/io/gltf.h): Debian's tinygltf, shipped as a shared library.
 find_package(TinyGLTF REQUIRED)
-# Offscreen rendering (src/render/) uses Mesa's OSMesa; see docs/rendering.md.
+# Offscreen rendering (src/render/) uses Mesa's OSMesa; see docs/guide/rendering.md.
 find_path(OSMESA_INCLUDE_DIR GL/osmesa.h REQUIRED)
 find_library(OSMESA_LIBRARY OSMesa REQUIRED)
 

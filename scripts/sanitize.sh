@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds diverse with GCC's AddressSanitizer and UndefinedBehaviorSanitizer
 # (-DDIVERSE_SANITIZE=ON) into ./build-asan, or the directory given, and runs the whole
-# test suite under them, the end-to-end tests included (docs/reliability.md, "Sanitizers").
+# test suite under them, the end-to-end tests included (docs/reference/reliability.md,
+# "Sanitizers").
 #
 #   scripts/sanitize.sh [BUILD_DIR] [CTEST_ARGS...]     e.g. scripts/sanitize.sh -R Rollout
 #

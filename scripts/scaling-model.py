@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Predicted wall time per generation and utilization of R ranks (docs/scaling.md).
+"""Predicted wall time per generation and utilization of R ranks (docs/guide/running-at-scale.md).
 
     scripts/scaling-model.py RUN_DIR... [--batches per-variation|per-generation|both]
                              [--popsize 16] [--n 4] [--threads 1] [--overhead-us US]

@@ -22,9 +22,9 @@ if [ "$mode" = all ]; then
     ffmpeg  # videos (diverse render)
     python3 python3-numpy python3-matplotlib  # examples/read_run.py (docs/python.md)
     jq  # scripts/reproduce-table1.sh and scripts/kill-resume.sh read the runs' summary.json
-    clang libclang-rt-14-dev  # the libFuzzer targets (fuzz/) and their test (docs/reliability.md)
+    clang libclang-rt-14-dev  # fuzz/ targets and their test (docs/reference/reliability.md)
     chromium
-    libopenmpi-dev openmpi-bin  # mpirun -n R diverse run (src/distribute/, docs/scaling.md)
+    libopenmpi-dev openmpi-bin  # mpirun -n R diverse run (docs/guide/running-at-scale.md)
   )
   # The gallery page (web/) is built with node and npm and tested in Chromium; a node that
   # is already installed (with its own npm) is used as it is.

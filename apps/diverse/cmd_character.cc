@@ -2,7 +2,7 @@
 // with its character file beside it) and prints what the controllers, constraints and
 // metrics will see: root, links, mass, standing height, internal DOF, joint groups with their
 // roles, joints, ranges and torque limits, feet, hands and shape parameters. Any problem is
-// the one-line error of docs/characters.md (exit code 2).
+// the one-line error of docs/guide/own-character.md (exit code 2).
 //
 //   diverse character assets/characters/human3d.toml
 #include <CLI/CLI.hpp>

@@ -1,7 +1,7 @@
 // `diverse cmaes`: runs the CMA-ES on a classic test function and prints one JSON
 // object (evaluations, generations, best_f, reached_target, stop_reason, ...).
 // This is how the optimizer is checked against the reference implementations;
-// docs/cmaes.md has the loop that produces its table.
+// docs/reference/cmaes.md has the loop that produces its table.
 #include <CLI/CLI.hpp>
 
 #include <charconv>

@@ -2,7 +2,7 @@
 // animation and 3D tools: RUN/export/m<i>.bvh (a skeleton and its channels, io/bvh.h) and
 // RUN/export/m<i>.glb (glTF 2.0: the bodies' own meshes and colours, animated, io/gltf.h),
 // plus RUN/export/all.glb with every motion side by side. Metres, Y up; see
-// docs/viewing-results.md for Blender's import settings.
+// docs/guide/viewing-results.md for Blender's import settings.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>

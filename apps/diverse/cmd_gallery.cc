@@ -2,7 +2,7 @@
 // RUN/gallery.html, with all motions of a finished run side by side in 3D, their
 // constraint values and distances, each variation's optimization path, and the run's
 // blends when `diverse blend RUN` made them. Opens from disk
-// in any browser, without network. See render/gallery.h and docs/viewing-results.md.
+// in any browser, without network. See render/gallery.h and docs/guide/viewing-results.md.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>

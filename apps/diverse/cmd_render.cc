@@ -1,7 +1,7 @@
 // `diverse render RUN [--half-speed] [--no-video] [--fps 30|60]`: the run's film strip
 // (RUN/filmstrip.png, the paper's figure 5) and videos (RUN/videos/m<i>.mp4 per motion,
 // RUN/videos/all.mp4 with all motions side by side), drawn from the recorded motions.
-// See render/run_media.h and docs/viewing-results.md.
+// See render/run_media.h and docs/guide/viewing-results.md.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>

@@ -1,5 +1,5 @@
 // `diverse robustness MOTION|RUN [--task FILE]`: the robustness suite (robust/robustness.h,
-// docs/robustness.md) on one motion or on every motion of a run: perturbed parameters,
+// docs/guide/robustness.md) on one motion or on every motion of a run: perturbed parameters,
 // pushes to the root in ground phases, friction lower and higher, the timestep halved;
 // per motion and kind, the share of perturbed rollouts that still meet the task.
 //

@@ -3,7 +3,8 @@
 //   diverse run backflip --n 4 --generations 500 --out runs/backflip
 //   diverse run backflip --vary shape --metric shape --out runs/backflip-shapes
 //   diverse resume runs/backflip
-//   mpirun -n 8 --hostfile hosts diverse run backflip --out runs/backflip   (docs/scaling.md)
+// mpirun -n 8 --hostfile hosts diverse run backflip --out runs/backflip
+// (docs/guide/running-at-scale.md)
 //
 // See src/run/run.h for what a run directory holds.
 #include <CLI/CLI.hpp>
@@ -141,7 +142,7 @@ void install_run(CLI::App& app) {
   cmd->add_flag("--robust", args->robust,
                 "A sample meets the task only if it also holds under a small seeded part of the "
                 "robustness suite (2 parameter perturbations, 2 pushes in the landing), judged "
-                "where a variation would move to it (docs/robustness.md)");
+                "where a variation would move to it (docs/guide/robustness.md)");
   cmd->add_option("--out", args->out, "Run directory (default: runs/<task>)");
   cmd->add_flag("--force", args->force, "Replace an existing run in the output directory");
   cmd->add_flag("--quiet", args->quiet, "No progress output");

@@ -323,7 +323,7 @@ void install(CLI::App& app) {
       ->check(number_in(1e-6, 1.0));
   cmd->add_option("--pushes", args->pushes,
                   "Robustness term: pushed rollouts per candidate, drawn as the robustness suite "
-                  "draws its pushes (0 = off; docs/robustness.md)")
+                  "draws its pushes (0 = off; docs/guide/robustness.md)")
       ->check(integer_in(0, 1000));
   cmd->add_option("--push-speed", args->push_speed, "Robustness term: the pushes' change of the root's speed (m/s)")
       ->capture_default_str()
@@ -350,7 +350,7 @@ void install(CLI::App& app) {
                 "A candidate meets the task only if it also holds under the robustness suite's "
                 "small part, as `diverse run --robust` judges samples (2 parameter perturbations, "
                 "2 pushes in the landing; 3 of 4 must hold); with --robustness-check, report "
-                "whether the motion holds it (docs/robustness.md)");
+                "whether the motion holds it (docs/guide/robustness.md)");
   cmd->add_flag("--robustness-check", args->robustness_check,
                 "Measure a motion instead of searching (default: the task's M0, or --start)");
   cmd->add_option("--check-sigmas", args->check_sigmas,
@@ -361,7 +361,7 @@ void install(CLI::App& app) {
                 "Robustness check of a jump: also simulate the motion and each perturbation at the "
                 "task's timestep, half and a quarter of it, and say how far apart their first "
                 "touch-downs are; a motion converged in the timestep comes down ever nearer one "
-                "spot as the step shrinks (docs/robustness.md)");
+                "spot as the step shrinks (docs/guide/robustness.md)");
   cmd->add_option("--check-samples", args->check_samples,
                   "Robustness check: perturbations per size (default 32)")
       ->check(integer_in(1, 100000));

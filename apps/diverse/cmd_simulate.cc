@@ -3,7 +3,7 @@
 // DIR/motion.json with the exact-replay record (src/io/motion_record.h), DIR/model.xml
 // (the exact MJCF text the motion ran on), and DIR/filmstrip.png with the
 // character at the phase events. A parameter file may also give the body shape as scales
-// "shape.NAME" (docs/shapes.md; a scale left out is 1); a motion file of a run with
+// "shape.NAME" (docs/guide/shapes.md; a scale left out is 1); a motion file of a run with
 // varying shape is such a file. `--strength S` simulates the strength model S (every
 // joint's PD gains and torque limits times S; model.xml carries the limits).
 #include <CLI/CLI.hpp>

@@ -5,7 +5,7 @@
 // Writes OUT/summary.json (settings, points, D, C, dmin, pairwise distances, clustering
 // and reach figures, paths) and OUT/toy.svg (region, reference in red, points, paths).
 // With --seeds M, runs seeds SEED..SEED+M-1 into OUT/seed-<s>/ and writes the mean and
-// sd of the figures over seeds to OUT/summary.json. See docs/toy.md.
+// sd of the figures over seeds to OUT/summary.json. See docs/guide/toy.md.
 #include <CLI/CLI.hpp>
 
 #include <cmath>

@@ -1,6 +1,6 @@
 // Ranges of command-line options.
 //
-// Every numeric option of every subcommand has a documented range (docs/reliability.md);
+// Every numeric option of every subcommand has a documented range (docs/reference/reliability.md);
 // these CLI11 validators enforce it on the text the user typed, before conversion, so
 // that a value out of range, a non-number, NaN, infinity or a number too large for its
 // type is one line "OPTION: expected ..., got 'TEXT'" and exit code 2, never a silent

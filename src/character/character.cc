@@ -204,7 +204,7 @@ std::string resolve_character_file(const std::string& path) {
     toml.replace_extension(".toml");
     if (!fs::is_regular_file(toml)) {
       throw UserError(path + ": expected a character file beside the model (" + toml.string() +
-                      "); docs/characters.md says how to write one");
+                      "); docs/reference/character-file.md says how to write one");
     }
     return toml.lexically_normal().string();
   }

@@ -3,7 +3,8 @@
 //   CharacterSpec spec = load_character_file("assets/characters/human2d.toml");
 //   Character body = bind_character(spec, model);   // indices into one compiled model
 //
-// The character file (TOML, docs/characters.md has every field) says what controllers,
+// The character file (TOML, docs/reference/character-file.md has every field) says what
+// controllers,
 // constraints and metrics need and the MJCF does not: the root (planar x/z/pitch slides
 // and hinge, or one free joint), the joint groups (each joint's role, the plane it turns
 // in, the left/right pairs that share targets), the feet and hands, the WJA weight of

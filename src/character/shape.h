@@ -14,7 +14,7 @@
 // everything else stay as written; inertias follow from the geometry (inertiafromgeom).
 // The root link's start height is set so that the character stands with the lowest point
 // of its feet (the character file's feet and every body below them) exactly where the
-// base model has it, all joints at 0. docs/shapes.md has the rules and the planar human's
+// base model has it, all joints at 0. docs/guide/shapes.md has the rules and the planar human's
 // parameters.
 //
 // A link's length L_i (m), the quantity that scales exactly by r: for a link with child

@@ -62,8 +62,8 @@
 // side given the shared parameter's value gives the symmetric controller's rollout bit for
 // bit (a stance phase's feet start from their mean measured pitch either way).
 //
-// Feedback options (`[controller]` keys, all off by default; docs/jumps3d.md, "Feedback for
-// the landing"):
+// Feedback options (`[controller]` keys, all off by default;
+// docs/notes/2026-12-05-robot-landing-feedback.md):
 //   yaw_kp, yaw_kd (Nm/rad, Nm s/rad; 0 to 5000, 0 to 1000)  every stance phase holds the
 //           root's yaw with two stance legs: equal and opposite pushes of the legs across
 //           the line between their feet, a moment about the vertical and no net force,
@@ -89,14 +89,14 @@
 //           leg, pushing by J^T, only while its foot touches the ground, and the feet track
 //           world pitches), so a push-off on the feet's front corners branched on which
 //           corner touched at which step; PD torques depend on the joints' state alone
-//           (docs/jumps3d.md, "A push-off in joint space").
+//           (docs/notes/2026-12-07-joint-space-push-off.md).
 //   extend_root_kd (Nm s/rad; 0 to 5000; with joint_space_extend)  in that extend the hips
 //           also damp the root's rotation: each hip hinge adds kd / 2 times the root's
 //           angular velocity about the hinge's axis, so the root feels -kd w about the
 //           hips' pitch and roll axes, as SIMBICON's stance hip holds the torso. It acts on
 //           the body's state alone, whichever feet touch, and takes out most of the spread
 //           of the angular momentum a perturbed push-off leaves the flight with
-//           (docs/jumps3d.md, "Damping the body's turn in the push-off").
+//           (docs/notes/2026-12-07-joint-space-push-off.md).
 //
 // No external force is ever applied: the root is unactuated and every torque goes through
 // the joint drive (physics/drive.h), which keeps it within the joint's limit on the net

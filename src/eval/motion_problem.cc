@@ -262,7 +262,7 @@ std::shared_ptr<MotionOutcome> MotionProblem::simulate_outcome(const Eigen::Vect
   // A walk ends at the step that breaks its rules (its C extrapolated from the steps so
   // far, task/walk_task.h). A jump runs to its end: whether a landing that misses the task
   // stands or falls decides its C, and only the rest of the rollout tells
-  // (docs/results.md, "Where a run's steps go").
+  // (docs/notes/2026-12-04-where-a-runs-steps-go.md).
   EvaluationOptions options;
   options.end_when_decided = evaluator_->task().walk.enabled;
   const Evaluation e = run(x, worker, options, *outcome);

@@ -24,7 +24,7 @@
 //       "model": "../model/m1.xml",   path of the MJCF, relative to this file: the exact
 //                                     text the motion ran on (MuJoCo's own writer keeps 6
 //                                     digits, which rotated frames and shaped bodies do
-//                                     not survive: docs/shapes.md)
+//                                     not survive: docs/guide/shapes.md)
 //       "timestep": 0.002, "nq": 19, "nu": 16,
 //       "qpos0": [...], "qvel0": [...],            initial state
 //       "damped_dofs": [...],                      dofs whose dof_damping the controller sets

@@ -5,7 +5,7 @@
 // cumulative step-size adaptation with the h_sigma stall, rank-one and rank-mu
 // covariance updates, and the active (negative-weight) update on by default with the
 // tutorial's scaling of the negative weights. Minimizes. Equation numbers in
-// cmaes.cc refer to that tutorial. docs/cmaes.md has the measured behaviour.
+// cmaes.cc refer to that tutorial. docs/reference/cmaes.md has the measured behaviour.
 //
 // Ask / tell: evaluation stays outside the optimizer, so callers may evaluate a
 // generation's samples in parallel, in any order, on any number of threads.

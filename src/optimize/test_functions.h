@@ -2,7 +2,7 @@
 // `diverse cmaes`.
 //
 // Definitions as in N. Hansen's pycma (cma.ff) and the CMA-ES reference figures in
-// docs/cmaes.md; all minima are 0:
+// docs/reference/cmaes.md; all minima are 0:
 //   sphere      f = sum x_i^2                                      min at 0
 //   ellipsoid   f = sum 1e6^((i-1)/(n-1)) x_i^2  (i = 1..n)         min at 0
 //   rosenbrock  f = sum_{i<n} 100 (x_{i+1} - x_i^2)^2 + (1 - x_i)^2  min at (1, .., 1)

@@ -61,7 +61,7 @@
 // the step (the backflip's hips in its push-off: divided by 3.5 at 2 ms, 2.3 at 1 ms), and
 // the same motion jumps differently at each step. With the constrained inertia the factor is
 // near 1 where the contacts hold the joint and as before where nothing does, so a motion
-// converges as the step shrinks (docs/robustness.md, "A drive that converges").
+// converges as the step shrinks (docs/notes/2026-12-05-drive-that-converges.md).
 //
 // An implicit joint can still exceed its limit if qdot_{t+1} jumps (an impact within the
 // step). run_rollout() (physics/rollout.h) therefore integrates, checks every implicit

@@ -2,7 +2,7 @@
 // RUN/gallery.html, that any browser opens from disk with no network.
 //
 // The page (source in web/, bundled with three.js into a template at build time; see
-// docs/viewing-results.md) shows all motions side by side in 3D, in step, with play/pause,
+// docs/guide/viewing-results.md) shows all motions side by side in 3D, in step, with play/pause,
 // a time scrubber and half speed; each motion's constraint value C and its distances to
 // the others (summary.json, every motion metric); and, per variation, a slider along its
 // optimization path (paper figure 6a).

@@ -7,7 +7,7 @@
 // more ways to fail on a user's machine for no gain in software. libmujoco does not link GL;
 // it loads its GL entry points from the context current when mjr_makeContext runs, so the
 // context is made current first (as MuJoCo's `record` sample does with -DMJ_OSMESA). Costs
-// are measured in docs/rendering.md.
+// are measured in docs/guide/rendering.md.
 //
 // Each renderer keeps its own copy of the model, adjusted for pictures: MuJoCo 2.2.2 draws
 // offscreen into a framebuffer sized by <visual><global offwidth offheight>, so the copy
@@ -136,7 +136,7 @@ class OffscreenRenderer {
  public:
   // Pictures of width x height pixels of `model`, which must outlive the renderer. Throws
   // std::invalid_argument on a bad size or supersample, std::runtime_error if no GL context
-  // can be created (see docs/rendering.md).
+  // can be created (see docs/guide/rendering.md).
   OffscreenRenderer(const mjModel* model, int width, int height, RenderStyle style = {});
   ~OffscreenRenderer();
   OffscreenRenderer(const OffscreenRenderer&) = delete;

@@ -49,7 +49,7 @@
 //
 // Cost: about 19 rollouts per motion with the defaults (8 + 8 + 2 + 1), plus the half-
 // timestep checks of the rollouts that hold on a task that asks for them, plus one
-// unperturbed rollout. docs/robustness.md has the measurements of every task's M0.
+// unperturbed rollout. docs/guide/robustness.md has the measurements of every task's M0.
 //
 // The push and the friction are the world's, never a controller's: the optimizer and a
 // run never set them (EvaluationOptions defaults to none), and the input-motion search
@@ -162,7 +162,7 @@ std::vector<MotionRobustness> run_robustness_suite(const TaskEvaluator& evaluato
                                                    const std::vector<MotionUnderTest>& motions,
                                                    const RobustnessSuite& suite, ThreadPool& pool);
 
-// robustness.json (docs/robustness.md): the suite's definition, then per motion the
+// robustness.json (docs/guide/robustness.md): the suite's definition, then per motion the
 // unperturbed C, per kind the counts and every perturbed rollout with its C.
 nlohmann::json robustness_json(const TaskEvaluator& evaluator, const RobustnessSuite& suite,
                                const std::vector<MotionRobustness>& results);

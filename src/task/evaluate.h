@@ -65,7 +65,7 @@ struct EvaluationOptions {
   // extrapolated to all its evaluated steps. A motion that meets the task is never ended,
   // so it is simulated exactly as without the option. The optimizer's walk rollouts use
   // it; its jumps do not (whether an ended landing would stand decides its C, and
-  // every constant in its place lowered D: docs/results.md, "Where a run's steps go").
+  // every constant in its place lowered D: docs/notes/2026-12-04-where-a-runs-steps-go.md).
   // Motion files, the robustness suite and the input-motion search simulate every
   // rollout to its end.
   bool end_when_decided = false;
@@ -167,7 +167,7 @@ class TaskEvaluator {
   std::vector<PoseSample> sample_poses(const Evaluation& e, int phase,
                                        const std::vector<double>& taus, SimWorker& worker) const;
 
-  // Body shape (character/shape.h, docs/shapes.md). Masses, joint ranges and torque
+  // Body shape (character/shape.h, docs/guide/shapes.md). Masses, joint ranges and torque
   // limits never change with the shape; link lengths, inertias and the start height do.
   //
   // True when the character can vary its shape: its character file has [shape]

@@ -9,7 +9,7 @@
 //
 // Parsing is strict: a missing field, an unknown key, a wrong type, an out-of-range
 // value, a model or parameter path that does not exist, or malformed TOML is a UserError
-// of one line, "FILE: FIELD: expected ...". docs/character-and-controller.md lists every
+// of one line, "FILE: FIELD: expected ...". docs/reference/task-file.md lists every
 // field.
 #pragma once
 
@@ -112,8 +112,8 @@ struct TaskSimulation {
   // about a second later. The landing's first topple_after seconds are left out: a
   // landing's impact and the swing of the upper body that catches it can carry both
   // points out and back (jump_over's landings do even later, and the backflip's within
-  // 0.4 s: docs/scaling.md, "Where a rollout ends"). 0: not checked (every committed
-  // task; docs/results.md, "Ending topples").
+  // 0.4 s: docs/guide/running-at-scale.md, "Where a rollout ends"). 0: not checked (every committed
+  // task; docs/notes/2026-12-04-where-a-runs-steps-go.md).
   double topple_distance = 0;
   double topple_after = 0.2;  // s
   // How the joint drive applies a request at the torque limit or with its spring part
@@ -125,13 +125,13 @@ struct TaskSimulation {
   // MuJoCo's implicit joint damping on each joint's own inertia, a saturated joint as
   // saturated_drive says) or "constrained" (every joint's PD torque solved together, each
   // damper on the velocity it will have at the step's end with the step's contacts held;
-  // a motion then converges as the step shrinks: docs/robustness.md, "A drive that
-  // converges"). saturated_drive has no say under "constrained".
+  // a motion then converges as the step shrinks: docs/notes/2026-12-05-drive-that-converges.md).
+  // saturated_drive has no say under "constrained".
   Damping damping = Damping::kMujoco;
   // The friction cone of every contact, MuJoCo's <option cone>: "" (the default: the
   // model's own), "elliptic" or "pyramidal". The planar human's model has the elliptic
   // one; under the pyramidal cone a change of friction that makes nothing slide still
-  // changes a push-off (docs/robustness.md, "Friction cones").
+  // changes a push-off (docs/notes/2026-12-06-friction-cones.md).
   std::string friction_cone;
 };
 

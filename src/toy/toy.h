@@ -5,7 +5,7 @@
 // inside a non-convex feasible region; the distance is the squared Euclidean distance.
 // The paper reports that K = 0 clusters the points at extremes of the region, K = 100
 // spreads them but stops short of the extremes, and K = 10 gets both. What our runs show
-// is in docs/toy.md.
+// is in docs/guide/toy.md.
 //
 // Our region (the paper does not give its shape) is a four-pointed star centred on the
 // reference point: two long spikes reaching 0.45 left and right, two short ones reaching
@@ -13,7 +13,7 @@
 // tips are the region's extremes, where K = 0 piles the points up; the four tips are four
 // well separated far places for K = 10 to spread over. (An L with the reference in the
 // elbow, or a crescent with it on the back, has only two extremes: there K = 10 keeps two
-// points at the ends and two beside the reference; see docs/toy.md.) Parameters are the
+// points at the ends and two beside the reference; see docs/guide/toy.md.) Parameters are the
 // point's coordinates, already in [0, 1]^2, so normalized and domain coordinates coincide.
 // The constraint is the paper's quadratic penalty (SPEC 2.4): C = 5000 |e|^2, e the
 // Euclidean distance from the point to the region (0 inside).

@@ -121,7 +121,7 @@ TEST(Character, AModelFileResolvesToTheCharacterFileBesideIt) {
     FAIL();
   } catch (const UserError& e) {
     EXPECT_EQ(std::string(e.what()), (dir / "lonely.xml").string() + ": expected a character file beside the model (" +
-                                         (dir / "lonely.toml").string() + "); docs/characters.md says how to write one");
+                                         (dir / "lonely.toml").string() + "); docs/reference/character-file.md says how to write one");
   }
 }
 

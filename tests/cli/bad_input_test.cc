@@ -3,7 +3,7 @@
 // expected, with exit code 2 (never an internal error, a crash or a hang). One test per
 // class of input: options of every subcommand, task files, character files and their
 // models, parameter files, motion files, run directories and checkpoints.
-// docs/reliability.md counts these cases.
+// docs/reference/reliability.md counts these cases.
 #include <gtest/gtest.h>
 
 #include <filesystem>

@@ -110,7 +110,7 @@ TEST(Jump3dExtendRootDamping, NeedsTheJointSpacePushOff) {
 }
 
 // Twelve perturbations at sigma 0.02 of one set of parameters, pushed off with and without
-// the damping: measured (docs/jumps3d.md) the take-off momentum's spread 10.5 kg m^2/s
+// the damping: measured (docs/reference/jump3d.md) the take-off momentum's spread 10.5 kg m^2/s
 // without, 4.4 with kd 200 (24 perturbations), the touch-down pitch's 31 and 17 degrees.
 TEST(Jump3dExtendRootDamping, NarrowsTheSpreadOfTheTakeOffMomentum) {
   const TakeOffs free = take_offs(robot_jump_with(0), 0.02, 12);

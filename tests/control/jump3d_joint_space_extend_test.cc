@@ -65,7 +65,7 @@ TEST(Jump3dJointSpaceExtend, ItsJumpMeetsTheTaskAtBothTimesteps) {
 
 // Sixteen perturbations at sigma 0.005 of each jump, left and right sharing their values:
 // their touch-downs at 2 ms and 1 ms measured 0.10 m apart on average under the
-// joint-space push-off (docs/jumps3d.md), against 0.74 m for the robot jump found under
+// joint-space push-off (docs/reference/jump3d.md), against 0.74 m for the robot jump found under
 // stance control's push-off, in its symmetric form (7 and 6 of 16 stand at both).
 TEST(Jump3dJointSpaceExtend, PerturbedJumpsLandAtBothTimestepsNearerEachOther) {
   const Spread joint = spread(load_task(kRoot + "/tests/control/data/robot_jump_joint_space_extend.toml"), 0.005, 16);

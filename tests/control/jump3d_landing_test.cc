@@ -117,7 +117,7 @@ TEST(Jump3dLanding, TheHeadTurnsTheBodyTowardItsLandingPitch) {
 }
 
 // A jump found under the three options (tests/control/data/robot_jump.landing_feedback.json;
-// docs/jumps3d.md, "Feedback for the landing") lands in the task's disc and stands at the
+// docs/notes/2026-12-05-robot-landing-feedback.md) lands in the task's disc and stands at the
 // task's timestep, and so do many of its perturbations at sigma 0.005 (8 of these 16 when
 // it was found); without the options the same parameters fall, and hardly any of their
 // perturbations stand (1 of 16).

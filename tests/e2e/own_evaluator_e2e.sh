@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The installed library from another project (examples/own-evaluator, docs/library.md):
+# The installed library from another project (examples/own-evaluator, docs/guide/library.md):
 # `cmake --install` into a temporary prefix, a standalone CMake project that finds it with
 # find_package(diverse) and links diverse::core, built and run: its own DiversityProblem
 # (a two-link arm) optimized into 3 variations that all meet its task.

@@ -59,7 +59,7 @@ TEST(RobustRun, ConfirmationJudgesTheSuitesPart) {
 
 // The robot's walk: its input motion holds the suite's part, so variations can move to
 // samples that hold it too, and some samples fail it (the jumps' input motions do not hold
-// it: docs/robustness.md).
+// it: docs/guide/robustness.md).
 TEST(RobustRun, ReturnsOnlyVariationsThatHold) {
   ThreadPool pool(2);
   const RobustFixture f("robot_silly_walk", pool.size());

@@ -75,7 +75,7 @@ bool bit_equal(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) 
 struct ReferenceCase {
   const char* function;
   int n;
-  double pycma_median;  // evaluations to f < 1e-10, seeds 1..10, pycma 4.4.0 (docs/cmaes.md)
+  double pycma_median;  // evaluations to f < 1e-10, seeds 1..10, pycma 4.4.0
 };
 
 class CmaesReference : public testing::TestWithParam<ReferenceCase> {};
@@ -114,7 +114,7 @@ TEST(Cmaes, SphereInHundredDimensionsReachesTarget) {
 }
 
 // Without negative weights the ellipsoid needs about 1.35x more evaluations
-// (libcmaes' passive column in docs/cmaes.md: 5780 vs 4235-4520).
+// (libcmaes' passive column in docs/reference/cmaes.md: 5780 vs 4235-4520).
 TEST(Cmaes, ActiveUpdateIsFasterOnEllipsoid) {
   const TestProblem& ellipsoid_problem = *find_test_problem("ellipsoid");
   std::vector<double> active, passive;

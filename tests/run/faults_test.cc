@@ -3,7 +3,7 @@
 // while checkpointing (a preloaded write() that runs out of space: ENOSPC, as a full
 // file system gives it). Each must end with the uninterrupted run's summary after
 // `diverse resume`, or with one clear error and the last good checkpoint intact and
-// resumable. scripts/kill-resume.sh is the 20-point experiment (docs/reliability.md).
+// resumable. scripts/kill-resume.sh is the 20-point experiment (docs/reference/reliability.md).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>

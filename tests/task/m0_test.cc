@@ -83,8 +83,8 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     // The 3D jumps: perturbed on both sides apart (their tasks' `asymmetric = true`) and
     // judged at half the timestep too; jump_backwards' measures 18 at 0.02, robot_jump's
     // (pushed off in joint space, the hips damping the body's turn) 9 at 0.005, where the
-    // one pushed off in joint space alone had 4 and the one before it none (docs/jumps3d.md,
-    // "A push-off in joint space", "Damping the body's turn in the push-off").
+    // one pushed off in joint space alone had 4 and the one before it none
+    // (docs/notes/2026-12-07-joint-space-push-off.md, "Damping the body's turn in the push-off").
     {"jump_backwards", {0.02, 32, 16}},
     {"robot_jump", {0.005, 32, 7}}};
 

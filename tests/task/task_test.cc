@@ -162,7 +162,7 @@ TEST_F(TaskFileTest, ValidTextParses) {
   EXPECT_EQ(t.diversity.generations, 500);
   EXPECT_EQ(load_task(write(valid_text() + "[diversity]\ngenerations = 200\n")).diversity.generations,
             200);
-  // The default job's own budget (docs/results.md, "The default job's budget").
+  // The default job's own budget (docs/notes/2026-12-04-where-a-runs-steps-go.md).
   EXPECT_EQ(load_task(kTasks + "jump_high.toml").diversity.generations, 200);
   EXPECT_DOUBLE_EQ(load_task(write(valid_text() + "[diversity]\nsigma0 = 0.03\n")).diversity.sigma0,
                    0.03);

@@ -136,7 +136,7 @@ double median(std::vector<double> v) {
 double lowest(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 double highest(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
 
-// Thresholds come from 10 seeds each (docs/toy.md): K = 0 clustering 0.09 +- 0.28 with
+// Thresholds come from 10 seeds each (docs/guide/toy.md): K = 0 clustering 0.09 +- 0.28 with
 // 9 of 10 seeds at 0, reach 0.96; K = 10 clustering 0.886 and reach 0.845 on every seed,
 // farthest point 0.005 outside; K = 100 farthest point 0.05 outside.
 TEST(ToyFigure2, KZeroClustersAtTheExtremes) {

@@ -651,7 +651,7 @@ for (const t of tiles) {
       t.robust.append(el('span', { class: `robust-total ${r.share >= 0.75 ? 'ok' : ''}` }, r.total), ': ');
       // Each kind's count kept on one line.
       r.kindList.forEach((k, j) => t.robust.append(j ? ', ' : '', el('span', { class: 'robust-kind' }, k)));
-      t.robust.title = 'Perturbed rollouts of this motion that still meet the task (the robustness suite, docs/robustness.md)';
+      t.robust.title = 'Perturbed rollouts of this motion that still meet the task (the robustness suite, docs/guide/robustness.md)';
     } else {
       t.robust.append('suite not run');
       t.robust.title = 'No robustness data for this motion: `diverse robustness RUN` measures it';
