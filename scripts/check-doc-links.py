@@ -7,6 +7,8 @@ Reads README.md, CHANGELOG.md and docs/**/*.md under ROOT (default: the reposito
 or image whose target is a path must name a file or directory that exists; a link with a
 #fragment into a Markdown file must name one of that file's headings, as GitHub makes
 heading anchors (lower case, punctuation dropped, spaces to hyphens, -1, -2 for repeats).
+Every page under docs/guide/, docs/reference/ and docs/notes/ must be linked from the index,
+docs/README.md, so that a reader finds it.
 Links to other sites (http:, https:, mailto:) are not fetched. Code blocks and inline code
 are skipped. Prints one line per broken link, FILE:LINE: TARGET: what is wrong, and exits 1
 if there is any.
@@ -85,6 +87,16 @@ def check(root):
                     if urllib.parse.unquote(fragment).lower() not in anchors(dest):
                         problems.append(f"{where}: expected a heading #{fragment} in "
                                         f"{dest.relative_to(root) if dest.is_relative_to(root) else dest}")
+    index = root / "docs" / "README.md"
+    if index.exists():
+        listed = set()
+        for line in strip_code(index.read_text(encoding="utf-8").splitlines()):
+            for m in LINK.finditer(line):
+                listed.add((index.parent / m.group(1).partition("#")[0]).resolve())
+        for part in ("guide", "reference", "notes"):
+            for page in sorted((root / "docs" / part).glob("*.md")):
+                if page.resolve() not in listed and page.name != "README.md":
+                    problems.append(f"{page.relative_to(root)}: expected a link to it in docs/README.md")
     return pages, links, problems
 
 
