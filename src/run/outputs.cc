@@ -206,6 +206,8 @@ void write_run_outputs(const RunOutputs& o) {
   if (objective.combined()) summary["shape_weight"] = objective.shape_weight;
   if (!o.messages.is_null()) summary["timing"]["messages"] = o.messages;
   if (!o.rollouts.is_null()) summary["timing"]["rollouts"] = o.rollouts;
+  // D, C and dmin above are under it; "distances" and distance_to_m0 are the built-in metrics'.
+  if (!o.custom.is_null()) summary["custom"] = o.custom;
 
   // The robustness suite (robust/robustness.h) on every motion: robustness.json in full,
   // and each motion's shares, by kind and over all, in the summary.

@@ -26,6 +26,7 @@ struct RunOutputs {
   int ranks = 1;            // processes that evaluated (mpirun -n; distribute/cluster.h)
   nlohmann::json messages = nullptr;  // ranks > 1: what went between them ("timing" "messages")
   nlohmann::json rollouts = nullptr;  // one process: its rollouts' CPU times ("timing" "rollouts")
+  nlohmann::json custom = nullptr;    // a program's own distance or constraint term (RunHooks)
 };
 
 // summary.json: the run's settings and result ("metric" the objective's distance, "vary"

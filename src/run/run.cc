@@ -213,9 +213,11 @@ class TimedPoolEvaluator : public BatchEvaluator {
 };
 
 // Rank 0 of several: workers get the settings; batches go over every rank.
+// `optimized` is the problem the optimizer runs on (`problem`, unless RunHooks wrap it).
 std::unique_ptr<BatchEvaluator> cluster_evaluator(Cluster* cluster, const RunSetup& setup,
-                                                  const MotionProblem& problem, ThreadPool& pool) {
-  if (!cluster) return std::make_unique<TimedPoolEvaluator>(problem, pool);
+                                                  const MotionProblem& problem,
+                                                  const DiversityProblem& optimized, ThreadPool& pool) {
+  if (!cluster) return std::make_unique<TimedPoolEvaluator>(optimized, pool);
   cluster->start_workers(cluster_setup(setup));
   return cluster->evaluator(problem, pool, &MotionProblem::decode);
 }
@@ -225,7 +227,7 @@ std::unique_ptr<BatchEvaluator> cluster_evaluator(Cluster* cluster, const RunSet
 void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& problem,
            DiversityOptimizer& optimizer, ThreadPool& pool, double wall_before,
            double checkpoint_seconds, bool quiet, bool render, Cluster* cluster,
-           const BatchEvaluator* batch) {
+           const BatchEvaluator* batch, const RunHooks& hooks) {
   const auto started = std::chrono::steady_clock::now();
   auto elapsed = [&] {
     return wall_before +
@@ -265,6 +267,13 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   try {
     while (!optimizer.done()) {
       optimizer.step();
+      if (hooks.on_generation && !hooks.on_generation(optimizer)) {
+        // Stopped by the caller: resumable like an interrupted run.
+        write_checkpoint();
+        if (progress) progress->finish("stopped after generation " + std::to_string(optimizer.generation()) +
+                                       "; " + resume_hint(dir, optimizer.generation()));
+        return;
+      }
       const auto now = std::chrono::steady_clock::now();
       if (std::chrono::duration<double>(now - last).count() >= checkpoint_seconds) {
         write_checkpoint();
@@ -288,6 +297,7 @@ void drive(const fs::path& dir, const RunSetup& setup, const MotionProblem& prob
   outputs.ranks = cluster ? cluster->size() : 1;
   if (cluster) outputs.messages = messages_json(cluster->traffic());
   if (const auto* timed = dynamic_cast<const TimedPoolEvaluator*>(batch)) outputs.rollouts = timed->to_json();
+  outputs.custom = hooks.custom;
   write_run_outputs(outputs);
   if (sink) std::fprintf(sink, "results in %s (summary.json, motions/, filmstrip.png)\n",
                          dir.string().c_str());
@@ -324,19 +334,26 @@ void start_run(const RunRequest& request) {
                              "filmstrip.png", "motions", "model", "paths"})
       fs::remove_all(request.out / name);
   }
+  if (request.hooks.wrap_problem && request.cluster)
+    throw std::logic_error("start_run: a wrapped problem runs in one process");
   ensure_writable_directory(request.out);
-  write_json_atomic(request.out / "run.json", run_json(setup));
+  nlohmann::json settings = run_json(setup);
+  if (!request.hooks.custom.is_null()) settings["custom"] = request.hooks.custom;
+  write_json_atomic(request.out / "run.json", settings);
 
   if (request.cluster) request.cluster->set_stop_message(stopped_line(request.out, -1));
 
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape, setup.bounds);
+  const std::unique_ptr<DiversityProblem> wrapped =
+      request.hooks.wrap_problem ? request.hooks.wrap_problem(problem) : nullptr;
+  const DiversityProblem& optimized = wrapped ? *wrapped : static_cast<const DiversityProblem&>(problem);
   std::unique_ptr<BatchEvaluator> batch;
   std::unique_ptr<DiversityOptimizer> started;
   try {
-    batch = cluster_evaluator(request.cluster, setup, problem, pool);
-    started = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+    batch = cluster_evaluator(request.cluster, setup, problem, optimized, pool);
+    started = std::make_unique<DiversityOptimizer>(optimized, setup.options, pool, batch.get());
   } catch (const ClusterError& e) {
     rethrow_resumable(e, request.out, -1);
   }
@@ -357,11 +374,11 @@ void start_run(const RunRequest& request) {
                  setup.evaluator->task().m0.c_str());
   }
   drive(request.out, setup, problem, optimizer, pool, 0.0, request.checkpoint_seconds,
-        request.quiet, request.render, request.cluster, batch.get());
+        request.quiet, request.render, request.cluster, batch.get(), request.hooks);
 }
 
 void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpoint_seconds,
-                bool render, Cluster* cluster) {
+                bool render, Cluster* cluster, const RunHooks& hooks) {
   const int threads = resolve_threads(threads_arg, cluster);
   if (!fs::is_directory(dir)) throw UserError(dir.string() + ": not a directory");
   if (!fs::exists(dir / "run.json"))
@@ -370,6 +387,9 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   const std::string where = (dir / "run.json").string();
   if (!run.is_object() || !run.contains("format") || run["format"] != kRunFormat)
     throw UserError(where + ": format: expected \"" + kRunFormat + "\"");
+  if (run.contains("custom") && !hooks.wrap_problem)
+    throw UserError(where + ": custom: the run's " + run["custom"].dump() +
+                    " is a program's own code; resume it from that program (Python: diverse.resume)");
   DiversityOptions options;
   try {
     options = diversity_options_from_json(run.at("options"));
@@ -404,6 +424,8 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
   ThreadPool pool(threads);
   const MotionProblem problem(*setup.evaluator, setup.distance, setup.m0.normalized(), pool.size(),
                               setup.vary_shape, setup.bounds);
+  const std::unique_ptr<DiversityProblem> wrapped = hooks.wrap_problem ? hooks.wrap_problem(problem) : nullptr;
+  const DiversityProblem& optimized = wrapped ? *wrapped : static_cast<const DiversityProblem&>(problem);
   // What a kill in the middle of a write left (the files themselves are whole: io/files.h).
   for (const char* sub : {"", "motions", "model", "paths"}) remove_stale_temporaries(dir / sub);
   double wall_before = 0.0;
@@ -414,26 +436,26 @@ void resume_run(const fs::path& dir, int threads_arg, bool quiet, double checkpo
     if (cluster) cluster->set_stop_message(stopped_line(dir, generation));
     std::unique_ptr<BatchEvaluator> batch;
     try {
-      batch = cluster_evaluator(cluster, setup, problem, pool);
-      optimizer = restore_optimizer(problem, state, pool, dir / "checkpoint.json", batch.get());
+      batch = cluster_evaluator(cluster, setup, problem, optimized, pool);
+      optimizer = restore_optimizer(optimized, state, pool, dir / "checkpoint.json", batch.get());
     } catch (const ClusterError& e) {
       rethrow_resumable(e, dir, generation);
     }
     drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster,
-          batch.get());
+          batch.get(), hooks);
   } else {
     // Stopped between writing run.json and its first checkpoint: run.json holds every
     // setting, so the run starts again from generation 0 (the same run, by determinism).
     if (cluster) cluster->set_stop_message(stopped_line(dir, -1));
     std::unique_ptr<BatchEvaluator> batch;
     try {
-      batch = cluster_evaluator(cluster, setup, problem, pool);
-      optimizer = std::make_unique<DiversityOptimizer>(problem, setup.options, pool, batch.get());
+      batch = cluster_evaluator(cluster, setup, problem, optimized, pool);
+      optimizer = std::make_unique<DiversityOptimizer>(optimized, setup.options, pool, batch.get());
     } catch (const ClusterError& e) {
       rethrow_resumable(e, dir, -1);
     }
     drive(dir, setup, problem, *optimizer, pool, wall_before, checkpoint_seconds, quiet, render, cluster,
-          batch.get());
+          batch.get(), hooks);
   }
 }
 

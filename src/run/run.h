@@ -35,6 +35,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -44,6 +46,22 @@
 namespace diverse {
 
 class Cluster;  // distribute/cluster.h
+
+// What a program that embeds the library adds to a run (the Python module, python/):
+struct RunHooks {
+  // Called after every generation; returning false stops the run there: its checkpoint
+  // is written (no summary), and resuming continues it as after an interruption.
+  std::function<bool(const DiversityOptimizer&)> on_generation;
+  // The problem the optimizer runs on in place of the task's own: a distance or a
+  // constraint term of the caller's over the task's problem. Its outcomes must be the
+  // task problem's MotionOutcomes (run/outputs.h reads them), and it must be pure like
+  // any DiversityProblem. Not with a cluster.
+  std::function<std::unique_ptr<DiversityProblem>(const MotionProblem&)> wrap_problem;
+  // What wrap_problem changes, e.g. {"metric": "my_metric"}: written as "custom" into
+  // run.json and summary.json. `diverse resume` refuses a run that has it (the CLI has
+  // not the caller's code); resume_run with the same hooks continues it.
+  nlohmann::json custom = nullptr;
+};
 
 struct RunRequest {
   std::string task;                 // task name or path (resolve_task_path)
@@ -64,6 +82,7 @@ struct RunRequest {
   Cluster* cluster = nullptr;       // rank 0 of several (mpirun): rollouts spread over
                                     // every rank; threads = 0 then means this node's
                                     // cores shared among its ranks
+  RunHooks hooks;                   // none by default
 };
 
 // Starts a run. Throws UserError on bad input or if `out` holds a run and !force.
@@ -73,8 +92,10 @@ void start_run(const RunRequest& request);
 // already finished only has its outputs written again; one stopped before its first
 // checkpoint starts again from run.json's settings. Throws UserError if `dir` is not
 // a run directory, its checkpoint is corrupt, or its task file changed.
+// `hooks` as in RunRequest: a run whose run.json has "custom" needs hooks.wrap_problem.
 void resume_run(const std::filesystem::path& dir, int threads, bool quiet = false,
-                double checkpoint_seconds = 5.0, bool render = true, Cluster* cluster = nullptr);
+                double checkpoint_seconds = 5.0, bool render = true, Cluster* cluster = nullptr,
+                const RunHooks& hooks = {});
 
 // A rank other than 0 of `mpirun -n R diverse run|resume`: waits for rank 0's settings,
 // builds the same problem from its own copy of the task's files (refusing, through rank
