@@ -20,7 +20,8 @@ if [ "$mode" = all ]; then
   packages+=(
     libgtest-dev libgmock-dev libbenchmark-dev
     ffmpeg  # videos (diverse render)
-    python3 python3-numpy python3-matplotlib  # examples/read_run.py (docs/python.md)
+    python3 python3-numpy python3-matplotlib  # examples/*.py (docs/guide/python.md)
+    pybind11-dev python3-pybind11 python3-dev python3-pytest  # the Python module (python/) and its tests
     jq  # scripts/reproduce-table1.sh and scripts/kill-resume.sh read the runs' summary.json
     clang libclang-rt-14-dev  # fuzz/ targets and their test (docs/reference/reliability.md)
     chromium

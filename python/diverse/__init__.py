@@ -30,6 +30,9 @@ from ._diverse import (  # noqa: F401  (the module's public names)
 )
 from . import _diverse
 
+for _public in (Motion, Outcome, Task, UserError):
+    _public.__module__ = "diverse"
+
 __all__ = [
     "Motion", "Outcome", "Task", "UserError", "distance", "distances", "load_task",
     "run", "resume", "load_run", "Run", "RunMotion", "StoppedRun",

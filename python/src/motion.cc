@@ -171,6 +171,12 @@ void bind_motion(py::module_& m) {
                              "(samples, angles): the joint angles (rad)")
       .def_property_readonly("root", [](const OutcomeView& v) { return roots(*v.outcome); },
                              "(samples, 4): the root's orientation, w x y z")
+      .def_property_readonly("link_mass",
+                             [](const OutcomeView& v) {
+                               const auto& poses = v.outcome->features.poses;
+                               return vector(poses.empty() ? Eigen::VectorXd() : poses[0].link_mass);
+                             },
+                             "kg, one per link (empty without pose samples)")
       .def_property_readonly("link_lengths",
                              [](const OutcomeView& v) { return vector(v.outcome->features.link_lengths); })
       .def_property_readonly("link_names", [](const OutcomeView& v) { return v.names->links; })

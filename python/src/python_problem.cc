@@ -13,7 +13,7 @@ namespace diverse::python {
 namespace {
 
 std::string name_of(const py::object& f) {
-  return py::str(py::getattr(f, "__qualname__", py::getattr(f, "__name__", py::str(py::repr(f)))));
+  return py::str(py::getattr(f, "__name__", py::str(py::repr(f))));
 }
 
 double checked(const py::object& value, const std::string& what, const py::object& f) {

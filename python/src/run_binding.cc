@@ -39,7 +39,7 @@ RunHooks python_hooks(const py::object& on_generation, const py::object& metric,
     };
     hooks.custom = nlohmann::json::object();
     auto name = [](const py::object& f) {
-      return py::str(py::getattr(f, "__qualname__", py::str(py::repr(f)))).cast<std::string>();
+      return py::str(py::getattr(f, "__name__", py::str(py::repr(f)))).cast<std::string>();
     };
     if (!metric.is_none()) hooks.custom["metric"] = "python: " + name(metric);
     if (!term.is_none()) hooks.custom["constraint"] = "python: " + name(term);
