@@ -1,22 +1,20 @@
 #!/usr/bin/env python3
-"""Reads a diverse run directory with the standard library, numpy and matplotlib.
+"""Reads a diverse run directory into numpy with the module diverse, and plots a motion.
 
-    python3 examples/read_run.py RUN [--variation I] [--joints NAME ...] [--out PNG]
+    PYTHONPATH=build/python /usr/bin/python3 examples/read_run.py RUN [--variation I] [--joints NAME ...] [--out PNG]
 
 Prints the run's summary (every motion's constraint value C and dmin, the distances under
-the run's metric), loads a motion file (motions/m<I>.json, default M1, or M0 if the run has
-no variation), names the columns of its recorded states from the model it ran on
-(model/m<I>.xml), and plots the chosen hinge joints' angles over time into a PNG (default
-RUN/m<I>-joints.png). Without --joints it plots the joints of the character's left leg
-(names ending in _l that contain hip, knee or ankle), or the first four hinges.
+the run's metric), takes one motion (default M1, or M0 if the run has no variation), names
+the columns of its recorded states from the model it ran on (model/m<I>.xml), and plots
+the chosen hinge joints' angles over time into a PNG (default RUN/m<I>-joints.png).
+Without --joints it plots the joints of the character's left leg (names ending in _l that
+contain hip, knee or ankle), or the first four hinges.
 
-The formats are those of src/run/run.h (summary.json) and src/io/motion_record.h (the
-motion file); docs/python.md explains them for Python users.
+docs/guide/python.md is the module's guide; the file formats are those of src/run/run.h
+(summary.json) and src/io/motion_record.h (the motion files).
 """
 import argparse
-import json
 import sys
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -25,62 +23,7 @@ import matplotlib
 matplotlib.use("Agg")  # files only, no display needed
 import matplotlib.pyplot as plt
 
-# Entries of qpos each joint type takes, in MuJoCo's order of joints in the model.
-QPOS_SIZE = {"free": 7, "ball": 4, "slide": 1, "hinge": 1}
-
-
-def joint_columns(model_xml):
-    """(name, type, first qpos column) of every joint, in the order MuJoCo lays out qpos:
-    the bodies' joints in document order. Joint types come from the element, else its
-    default class (childclass of the bodies above it, or `class`), else "hinge"."""
-    root = ET.parse(model_xml).getroot()
-    defaults = {}  # class name -> joint type
-
-    def read_defaults(node, inherited, name):
-        joint = node.find("joint")
-        kind = joint.get("type", inherited) if joint is not None else inherited
-        defaults[name] = kind
-        for child in node.findall("default"):
-            read_defaults(child, kind, child.get("class", name))
-
-    for top in root.findall("default"):
-        read_defaults(top, "hinge", top.get("class", "main"))
-
-    columns = []
-    qpos = 0
-
-    def walk(body, childclass):
-        nonlocal qpos
-        childclass = body.get("childclass", childclass)
-        for element in body:
-            if element.tag == "freejoint":
-                kind, name = "free", element.get("name", "")
-            elif element.tag == "joint":
-                cls = element.get("class", childclass)
-                kind = element.get("type", defaults.get(cls, defaults.get("main", "hinge")))
-                name = element.get("name", "")
-            else:
-                continue
-            columns.append((name, kind, qpos))
-            qpos += QPOS_SIZE[kind]
-        for child in body.findall("body"):
-            walk(child, childclass)
-
-    for world in root.findall("worldbody"):
-        for body in world.findall("body"):
-            walk(body, "main")
-    return columns, qpos
-
-
-def load_motion(run, index):
-    """The motion file as a dict, its times (s) and states (steps x nq) as numpy arrays."""
-    path = run / "motions" / f"m{index}.json"
-    motion = json.loads(path.read_text())
-    replay = motion["replay"]
-    qpos = np.array([replay["qpos0"]] + replay["qpos"], dtype=float)
-    times = np.arange(len(qpos)) * replay["timestep"]
-    model = (path.parent / replay["model"]).resolve()
-    return motion, times, qpos, model
+import diverse
 
 
 def main(argv):
@@ -92,20 +35,20 @@ def main(argv):
     parser.add_argument("--columns", action="store_true", help="print the model's joints and their qpos columns")
     args = parser.parse_args(argv)
 
-    summary_path = args.run / "summary.json"
-    if not summary_path.exists():
-        print(f"read_run.py: {summary_path}: missing; not a finished run directory", file=sys.stderr)
+    try:
+        run = diverse.load_run(args.run)
+    except diverse.UserError as e:
+        print(f"read_run.py: {e}", file=sys.stderr)
         return 2
-    summary = json.loads(summary_path.read_text())
-    motions = summary["motions"]
+    summary = run.summary
+    motions = run.motions
     metric = summary.get("metric", "")
-    print(f"{summary.get('task', '?')}: {len(motions)} motions, metric {metric}, D = {summary.get('D', float('nan')):.4g}")
+    print(f"{summary.get('task', '?')}: {len(motions)} motions, metric {metric}, D = {run.D:.4g}")
     print(f"{'motion':>6} {'C':>10} {'dmin':>10}")
     for m in motions:
-        print(f"{m['label']:>6} {m['constraint']:>10.4g} {m.get('dmin', 0.0):>10.4g}")
-    distances = summary.get("distances", {}).get(metric)
-    if distances:
-        d = np.array(distances)
+        print(f"{m.label:>6} {m.constraint:>10.4g} {m.dmin:>10.4g}")
+    if metric in summary.get("distances", {}):
+        d = run.distances(metric)
         print(f"distances under {metric}: closest pair {d[np.triu_indices(len(d), 1)].min():.4g}, "
               f"farthest {d.max():.4g}")
 
@@ -113,12 +56,9 @@ def main(argv):
     if not 0 <= index < len(motions):
         print(f"read_run.py: --variation: expected 0 to {len(motions) - 1}, got {index}", file=sys.stderr)
         return 2
-    motion, times, qpos, model = load_motion(args.run, index)
-    columns, nq = joint_columns(model)
-    if nq != qpos.shape[1]:
-        print(f"read_run.py: {model}: {nq} qpos columns from the joints, the motion has {qpos.shape[1]}",
-              file=sys.stderr)
-        return 2
+    motion = motions[index]
+    times, qpos, model = motion.times, motion.qpos, Path(motion.model)
+    columns = diverse.joints(motion.model)  # (name, type, first qpos column), as MuJoCo lays them out
     if args.columns:
         for name, kind, column in columns:
             print(f"column {column:>3} {kind:<6} {name}")
@@ -137,12 +77,11 @@ def main(argv):
     for name in names:
         ax.plot(times, np.degrees(qpos[:, hinges[name]]), label=name, linewidth=1.6)
     # The phases the controller reported, as vertical lines.
-    for phase in motion.get("phases", []):
-        if phase.get("begin", -1) > 0:
-            ax.axvline(phase["begin"], color="#999999", linewidth=0.8, linestyle=":")
-            ax.text(phase["begin"], ax.get_ylim()[1], " " + phase["name"], fontsize=7, va="top", color="#666666")
-    label = motions[index]["label"]
-    ax.set_title(f"{summary.get('task', '')} {label}: joint angles (C = {motions[index]['constraint']:.3g})")
+    for name, begin in motion.phases.items():
+        if begin > 0:
+            ax.axvline(begin, color="#999999", linewidth=0.8, linestyle=":")
+            ax.text(begin, ax.get_ylim()[1], " " + name, fontsize=7, va="top", color="#666666")
+    ax.set_title(f"{summary.get('task', '')} {motion.label}: joint angles (C = {motion.constraint:.3g})")
     ax.set_xlabel("time (s)")
     ax.set_ylabel("angle (degrees)")
     ax.grid(True, alpha=0.3)

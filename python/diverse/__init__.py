@@ -26,6 +26,7 @@ from ._diverse import (  # noqa: F401  (the module's public names)
     __version__,
     distance,
     distances,
+    joints,
     load_task,
 )
 from . import _diverse
@@ -34,7 +35,7 @@ for _public in (Motion, Outcome, Task, UserError):
     _public.__module__ = "diverse"
 
 __all__ = [
-    "Motion", "Outcome", "Task", "UserError", "distance", "distances", "load_task",
+    "Motion", "Outcome", "Task", "UserError", "distance", "distances", "joints", "load_task",
     "run", "resume", "load_run", "Run", "RunMotion", "StoppedRun",
 ]
 

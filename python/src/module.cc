@@ -6,6 +6,7 @@
 
 #include "binding.h"
 #include "core/error.h"
+#include "physics/model.h"
 #include "task/task.h"
 
 namespace diverse::python {
@@ -132,6 +133,21 @@ void bind_task(py::module_& m) {
                " parameters>";
       });
 
+  m.def(
+      "joints",
+      [](const std::string& model_path) {
+        // Every joint of an MJCF and where it sits in qpos, as MuJoCo lays them out.
+        const auto model = SharedModel::from_file(model_path);
+        const mjModel* mm = model->get();
+        static const char* kinds[] = {"free", "ball", "slide", "hinge"};
+        py::list joints;
+        for (int j = 0; j < mm->njnt; ++j) {
+          const char* name = mj_id2name(mm, mjOBJ_JOINT, j);
+          joints.append(py::make_tuple(name ? name : "", kinds[mm->jnt_type[j]], mm->jnt_qposadr[j]));
+        }
+        return joints;
+      },
+      py::arg("model"), "[(name, type, first qpos column)] of every joint of an MJCF file (a run's model/m<i>.xml)");
   m.def(
       "load_task",
       [](const std::string& name_or_path, double strength) {

@@ -1,27 +1,29 @@
 #!/usr/bin/env bash
-# examples/read_run.py on a short real run: it prints every motion's C and dmin, names the
-# recorded states' columns from the model (the planar human's root slides and hinge first),
-# plots a variation's joint angles into a PNG, and refuses an unknown joint in one line
-# with exit code 2.
+# examples/read_run.py (the module diverse) on a short real run: it prints every motion's
+# C and dmin, names the recorded states' columns from the model (the planar human's root
+# slides and hinge first), plots a variation's joint angles into a PNG, and refuses an
+# unknown joint in one line with exit code 2.
 #
 #   read_run_e2e.sh DIVERSE_BINARY SOURCE_DIR
 #
-# Exits 77 (CTest: skipped) when python3 lacks numpy or matplotlib (scripts/setup.sh
-# installs python3-numpy and python3-matplotlib).
+# Exits 77 (CTest: skipped) when no python3 has numpy, matplotlib and the module diverse
+# built beside DIVERSE_BINARY (scripts/setup.sh installs python3-numpy, python3-matplotlib
+# and pybind11; the build makes BUILD/python/diverse for /usr/bin/python3).
 set -euo pipefail
 diverse="$1"
 src="$2"
-# The first python3 on PATH with numpy and matplotlib; Debian's packages are those of
-# /usr/bin/python3, which another python3 (a virtual environment, pyenv) may shadow.
+export PYTHONPATH="$(cd "$(dirname "$diverse")" && pwd)/python${PYTHONPATH:+:$PYTHONPATH}"
+# Debian's python3 first: the module is built for it, and another python3 on the PATH (a
+# virtual environment, pyenv) may shadow it.
 python=""
-for candidate in python3 /usr/bin/python3; do
-  if command -v "$candidate" >/dev/null && "$candidate" -c 'import numpy, matplotlib' 2>/dev/null; then
+for candidate in /usr/bin/python3 python3; do
+  if command -v "$candidate" >/dev/null && "$candidate" -c 'import numpy, matplotlib, diverse' 2>/dev/null; then
     python="$candidate"
     break
   fi
 done
 if [ -z "$python" ]; then
-  echo "SKIPPED: python3 with numpy and matplotlib is not installed (scripts/setup.sh installs them)"
+  echo "SKIPPED: no python3 with numpy, matplotlib and the module diverse (scripts/setup.sh, then the build)"
   exit 77
 fi
 work="$(mktemp -d)"
