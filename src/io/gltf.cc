@@ -206,6 +206,17 @@ class Writer {
     return static_cast<int>(model_.accessors.size()) - 1;
   }
 
+  // An unsigned short accessor (JOINTS_0), `width` per element.
+  int ushorts(const std::vector<std::uint16_t>& values, int width, int type) {
+    tinygltf::Accessor a;
+    a.bufferView = view(values.data(), values.size() * 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+    a.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    a.count = values.size() / static_cast<std::size_t>(width);
+    a.type = type;
+    model_.accessors.push_back(a);
+    return static_cast<int>(model_.accessors.size()) - 1;
+  }
+
   int indices(const std::vector<std::uint32_t>& index, std::size_t vertices) {
     tinygltf::Accessor a;
     if (vertices <= 65535) {
@@ -229,6 +240,31 @@ class Writer {
 std::string body_name(const mjModel* m, int b) {
   const char* raw = mj_id2name(m, mjOBJ_BODY, b);
   return raw && *raw ? raw : "body" + std::to_string(b);
+}
+
+// The humanoid bone each body of the human characters (assets/characters/human2d.xml,
+// human3d.xml) stands for, named as Unity's Humanoid avatar and Godot's
+// SkeletonProfileHumanoid name them, so that retargeting tools can map the skeleton
+// (docs/guide/engines.md). Used only for a model whose first body is "pelvis".
+const std::map<std::string, std::string>& humanoid_bones() {
+  static const std::map<std::string, std::string> bones = {
+      {"pelvis", "Hips"},          {"abdomen", "Spine"},         {"torso", "Spine"},
+      {"chest", "Chest"},          {"neck", "Neck"},             {"head", "Head"},
+      {"upperarm_l", "LeftUpperArm"}, {"forearm_l", "LeftLowerArm"}, {"hand_l", "LeftHand"},
+      {"upperarm_r", "RightUpperArm"}, {"forearm_r", "RightLowerArm"}, {"hand_r", "RightHand"},
+      {"thigh_l", "LeftUpperLeg"}, {"shin_l", "LeftLowerLeg"},  {"foot_l", "LeftFoot"},
+      {"thigh_r", "RightUpperLeg"}, {"shin_r", "RightLowerLeg"}, {"foot_r", "RightFoot"}};
+  return bones;
+}
+
+// MuJoCo's 3x3 rotation (row-major) in glTF axes: C R C^T with C (x, y, z) -> (x, z, -y).
+std::array<double, 9> rotation_to_gltf(const double* r) {
+  const int row[3] = {0, 2, 1};
+  const double sign[3] = {1, 1, -1};
+  std::array<double, 9> out{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out[static_cast<std::size_t>(3 * i + j)] = sign[i] * sign[j] * r[3 * row[i] + row[j]];
+  return out;
 }
 
 }  // namespace
@@ -324,6 +360,69 @@ void write_glb(const std::filesystem::path& path, const std::vector<GltfMotion>&
       return static_cast<int>(model.meshes.size()) - 1;
     };
 
+    // The skinned character: one mesh of every body's geoms at the bind pose (the model's
+    // qpos0), each vertex bound to its body's joint with weight 1 (rigid skinning).
+    auto skinned_mesh = [&](const std::string& name, int* bound_joints) {
+      std::unique_ptr<mjData, DataDeleter> bind(mj_makeData(m));
+      mj_kinematics(m, bind.get());
+      tinygltf::Mesh mesh;
+      mesh.name = name;
+      *bound_joints = 0;
+      for (int g = 0; g < m->ngeom; ++g) {
+        const int b = m->geom_bodyid[g];
+        if (b == 0 || !visible(m, g)) continue;
+        const TriMesh tri = geom_mesh(m, g, options);
+        if (tri.index.empty()) continue;
+        const double* x = bind->xpos + 3 * b;
+        const double* r = bind->xmat + 9 * b;
+        std::vector<float> pos, nrm, weights;
+        std::vector<std::uint16_t> joints;
+        for (std::size_t k = 0; k < tri.position.size(); ++k) {
+          const Vec3& p = tri.position[k];
+          const Vec3& n = tri.normal[k];
+          double wp[3], wn[3];
+          for (int i = 0; i < 3; ++i) {
+            wp[i] = x[i] + r[3 * i] * p[0] + r[3 * i + 1] * p[1] + r[3 * i + 2] * p[2];
+            wn[i] = r[3 * i] * n[0] + r[3 * i + 1] * n[1] + r[3 * i + 2] * n[2];
+          }
+          for (double v : to_gltf(wp)) pos.push_back(static_cast<float>(v));
+          for (double v : to_gltf(wn)) nrm.push_back(static_cast<float>(v));
+          // Joint b - 1 of the skin (its joints are bodies 1..nbody-1); unused slots 0.
+          joints.insert(joints.end(), {static_cast<std::uint16_t>(b - 1), 0, 0, 0});
+          weights.insert(weights.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+        }
+        tinygltf::Primitive p;
+        p.attributes["POSITION"] = writer.floats(pos, 3, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+        p.attributes["NORMAL"] = writer.floats(nrm, 3, TINYGLTF_TYPE_VEC3, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+        p.attributes["JOINTS_0"] = writer.ushorts(joints, 4, TINYGLTF_TYPE_VEC4);
+        p.attributes["WEIGHTS_0"] = writer.floats(weights, 4, TINYGLTF_TYPE_VEC4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+        p.indices = writer.indices(tri.index, tri.position.size());
+        p.material = material(g);
+        p.mode = TINYGLTF_MODE_TRIANGLES;
+        mesh.primitives.push_back(p);
+      }
+      // Inverse bind matrices: the inverse of every body's world transform at the bind
+      // pose (glTF axes), column-major: [R^T, -R^T x; 0 0 0 1].
+      std::vector<float> ibm;
+      for (int b = 1; b < m->nbody; ++b) {
+        const std::array<double, 9> r = rotation_to_gltf(bind->xmat + 9 * b);
+        const Vec3 x = to_gltf(bind->xpos + 3 * b);
+        double t[3];
+        for (int i = 0; i < 3; ++i) t[i] = -(r[static_cast<std::size_t>(i)] * x[0] + r[static_cast<std::size_t>(3 + i)] * x[1] +
+                                             r[static_cast<std::size_t>(6 + i)] * x[2]);
+        // Column j of R^T is row j of R.
+        for (int j = 0; j < 3; ++j) {
+          for (int i = 0; i < 3; ++i) ibm.push_back(static_cast<float>(r[static_cast<std::size_t>(3 * j + i)]));
+          ibm.push_back(0.0f);
+        }
+        ibm.insert(ibm.end(), {static_cast<float>(t[0]), static_cast<float>(t[1]), static_cast<float>(t[2]), 1.0f});
+      }
+      *bound_joints = writer.floats(ibm, 16, TINYGLTF_TYPE_MAT4, 0, false);
+      if (mesh.primitives.empty()) return -1;
+      model.meshes.push_back(mesh);
+      return static_cast<int>(model.meshes.size()) - 1;
+    };
+
     // The motion's node, placed by its offset.
     tinygltf::Node top;
     top.name = motion.name.empty() ? "motion" : motion.name;
@@ -345,14 +444,39 @@ void write_glb(const std::filesystem::path& path, const std::vector<GltfMotion>&
     // Body nodes, parents before children (MuJoCo's body order).
     std::vector<int> node_of(static_cast<std::size_t>(m->nbody), -1);
     node_of[0] = top_index;
+    const bool human = m->nbody > 1 && body_name(m, 1) == "pelvis";
     for (int b = 1; b < m->nbody; ++b) {
       tinygltf::Node node;
       node.name = prefix + body_name(m, b);
-      node.mesh = body_mesh(b, node.name);
+      if (!options.skinned) node.mesh = body_mesh(b, node.name);
+      if (const auto bone = humanoid_bones().find(body_name(m, b)); human && bone != humanoid_bones().end())
+        node.extras = tinygltf::Value(tinygltf::Value::Object{{"humanoid_bone", tinygltf::Value(bone->second)}});
       model.nodes.push_back(node);
       node_of[static_cast<std::size_t>(b)] = static_cast<int>(model.nodes.size()) - 1;
       model.nodes[static_cast<std::size_t>(node_of[static_cast<std::size_t>(m->body_parentid[b])])]
           .children.push_back(node_of[static_cast<std::size_t>(b)]);
+    }
+
+    // The skin over the body nodes and its mesh, a node of the scene's root (a skinned
+    // mesh's own transform is ignored; the joints place it).
+    if (options.skinned && m->nbody > 1) {
+      int ibm = -1;
+      const std::string name = (motion.name.empty() ? std::string("motion") : motion.name) + " body";
+      const int mesh = skinned_mesh(name, &ibm);
+      tinygltf::Skin skin;
+      skin.name = name;
+      skin.inverseBindMatrices = ibm;
+      skin.skeleton = top_index;
+      for (int b = 1; b < m->nbody; ++b) skin.joints.push_back(node_of[static_cast<std::size_t>(b)]);
+      model.skins.push_back(skin);
+      if (mesh >= 0) {
+        tinygltf::Node node;
+        node.name = name;
+        node.mesh = mesh;
+        node.skin = static_cast<int>(model.skins.size()) - 1;
+        model.nodes.push_back(node);
+        scene.nodes.push_back(static_cast<int>(model.nodes.size()) - 1);
+      }
     }
 
     // Each body's pose in its parent at every frame.

@@ -4,14 +4,22 @@
 //   write_glb("export/m1.glb", {{model, frames, "M1"}}, 30.0);
 //
 // What a file holds:
-//   - One node per moving body, named after it, nested as the bodies are (the root body a
-//     child of the motion's own node, named after the motion: "M1"), each with its own
-//     mesh: the body's visible geoms (MuJoCo groups 0-2; capsules, cylinders, spheres,
+//   - A skinned character (GltfOptions::skinned, the default), as Blender, three.js and
+//     game engines play characters: a skeleton of one joint node per moving body, named
+//     after it, nested as the bodies are (the root body a child of the motion's own node,
+//     named after the motion: "M1"), with a skin whose inverse bind matrices are the
+//     bodies' world transforms at the model's qpos0 inverted; and one mesh ("M1 body", a
+//     node of the scene's root) of every body's geoms at that pose, each vertex bound to
+//     its body's joint with weight 1. The joints of the human characters carry the
+//     humanoid bone they stand for in their extras ({"humanoid_bone": "LeftUpperLeg"}:
+//     Unity's and Godot's humanoid names; docs/guide/engines.md has the table).
+//   - Or, not skinned: each body node with its own mesh.
+//   - A body's mesh: its visible geoms (MuJoCo groups 0-2; capsules, cylinders, spheres,
 //     ellipsoids and boxes, as triangle meshes with normals, in the geom's place in the
 //     body) in the model's colours (geom rgba or its material's, taken as sRGB, so they look
 //     as in MuJoCo and the gallery). Static scene geoms (a box to jump onto) are one more
 //     node, "<motion> scene". The floor plane is left out.
-//   - One animation, "motion": per body node its rotation in its parent, and the
+//   - One animation, "motion": per body (joint) node its rotation in its parent, and the
 //     translation of every node whose place in its parent changes (the root body's; any
 //     body moved by a slide joint), sampled at the given frame rate from the recorded
 //     states (linear interpolation, unit quaternions). Several motions in one file share
@@ -44,6 +52,8 @@ struct GltfMotion {
 
 struct GltfOptions {
   double fps = 30.0;
+  // A skinned character (the default) or rigid body nodes (see the top of this file).
+  bool skinned = true;
   int slices = 20;  // segments around a capsule, cylinder or sphere
   int stacks = 10;  // rings from pole to pole of a sphere (half of them per capsule cap)
 };

@@ -1,5 +1,7 @@
 // glTF export: the file reads back with tinygltf; it has one node per body, nested as the
-// bodies are, each with a mesh of its geoms in the model's colours; and its animation,
+// bodies are, each with a mesh of its geoms in the model's colours (rigid) or one skinned
+// mesh over them (the default: its skin's joint transforms, composed over the animation,
+// put every bone and every vertex where MuJoCo puts them); and its animation,
 // evaluated at every keyframe and composed down the node tree, puts every body where MuJoCo
 // does (position and orientation, in glTF's Y-up axes), for the 3D human pushed sideways,
 // the bird robot and the planar human. Several motions side by side keep their own bodies,
@@ -11,10 +13,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <unistd.h>
+
+#include <Eigen/Geometry>
 
 #include "core/error.h"
 #include "character/character.h"
@@ -138,12 +143,168 @@ void expect_matches_mujoco(const mjModel* m, const std::vector<std::vector<doubl
   }
 }
 
+GltfOptions rigid() {
+  GltfOptions o;
+  o.skinned = false;
+  return o;
+}
+
+// A node's world transform at keyframe k (glTF axes).
+Eigen::Affine3d world_of(const NodePose& pose, int node) {
+  const auto& p = pose.pos[static_cast<std::size_t>(node)];
+  const auto& q = pose.quat[static_cast<std::size_t>(node)];
+  Eigen::Affine3d t = Eigen::Affine3d::Identity();
+  t.translate(Eigen::Vector3d(p[0], p[1], p[2]));
+  t.rotate(Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized());
+  return t;
+}
+
+Eigen::Vector3d to_gltf(const Eigen::Vector3d& v) { return {v[0], v[2], -v[1]}; }
+
+// The skinned character: a skin over one joint per body, in body order, with the
+// humanoid names on the 3D human's joints; composing each joint's world transform at
+// every keyframe with its inverse bind matrix moves the bind pose's bones and vertices to
+// where MuJoCo puts the bodies and their geoms, within 1 mm (float precision: 1e-5 m).
+TEST(GltfSkin, Human3dSkinComposesToMujocoBodies) {
+  const auto motion = test_support::stance_motion("human3d", {0.2, 0.3, 0.0}, 1.5);
+  const mjModel* m = motion.model->get();
+  const auto frames = recorded_frames(motion.record, 17);
+  const fs::path file = temp_dir() / "skinned.glb";
+  write_glb(file, {GltfMotion{m, frames, "M0", {0.5, 1.0, 0}}});
+  const tinygltf::Model g = read_glb(file);
+  ASSERT_EQ(g.skins.size(), 1u);
+  const tinygltf::Skin& skin = g.skins[0];
+  ASSERT_EQ(skin.joints.size(), static_cast<std::size_t>(m->nbody - 1));  // 15 bones
+  for (int b = 1; b < m->nbody; ++b)
+    EXPECT_EQ(g.nodes[static_cast<std::size_t>(skin.joints[static_cast<std::size_t>(b - 1)])].name,
+              mj_id2name(m, mjOBJ_BODY, b));
+  EXPECT_EQ(g.nodes[static_cast<std::size_t>(skin.skeleton)].name, "M0");
+  // The humanoid names.
+  std::map<std::string, std::string> humanoid;
+  for (int j : skin.joints) {
+    const auto& node = g.nodes[static_cast<std::size_t>(j)];
+    EXPECT_LT(node.mesh, 0) << node.name;  // joints carry no meshes of their own
+    if (node.extras.Has("humanoid_bone")) humanoid[node.name] = node.extras.Get("humanoid_bone").Get<std::string>();
+  }
+  EXPECT_EQ(humanoid.size(), 15u);
+  EXPECT_EQ(humanoid["pelvis"], "Hips");
+  EXPECT_EQ(humanoid["torso"], "Spine");
+  EXPECT_EQ(humanoid["thigh_l"], "LeftUpperLeg");
+  EXPECT_EQ(humanoid["forearm_r"], "RightLowerArm");
+  // The skinned mesh: a root node of the scene, one primitive per visible geom, each vertex
+  // on one joint with weight 1.
+  int mesh_node = -1;
+  for (int n : g.scenes[0].nodes)
+    if (g.nodes[static_cast<std::size_t>(n)].skin == 0) mesh_node = n;
+  ASSERT_GE(mesh_node, 0);
+  const tinygltf::Node& skinned = g.nodes[static_cast<std::size_t>(mesh_node)];
+  EXPECT_EQ(skinned.name, "M0 body");
+  EXPECT_TRUE(skinned.translation.empty() && skinned.rotation.empty() && skinned.matrix.empty());
+  const tinygltf::Mesh& mesh = g.meshes[static_cast<std::size_t>(skinned.mesh)];
+  int geoms = 0;
+  for (int gi = 0; gi < m->ngeom; ++gi) geoms += m->geom_bodyid[gi] > 0 && m->geom_group[gi] <= 2;
+  EXPECT_EQ(mesh.primitives.size(), static_cast<std::size_t>(geoms));
+
+  const tinygltf::Accessor& ibm_accessor = g.accessors[static_cast<std::size_t>(skin.inverseBindMatrices)];
+  ASSERT_EQ(ibm_accessor.type, TINYGLTF_TYPE_MAT4);
+  ASSERT_EQ(ibm_accessor.count, skin.joints.size());
+  const tinygltf::BufferView& ibm_view = g.bufferViews[static_cast<std::size_t>(ibm_accessor.bufferView)];
+  std::vector<float> ibm_floats(16 * skin.joints.size());
+  std::memcpy(ibm_floats.data(), g.buffers[0].data.data() + ibm_view.byteOffset, ibm_floats.size() * sizeof(float));
+  std::vector<Eigen::Matrix4d> ibm;
+  for (std::size_t j = 0; j < skin.joints.size(); ++j)
+    ibm.push_back(Eigen::Map<const Eigen::Matrix4f>(ibm_floats.data() + 16 * j).cast<double>());
+
+  // Every primitive's vertices at the bind pose, with their joints.
+  struct Vertex {
+    Eigen::Vector3d bind;
+    int joint;
+  };
+  std::vector<Vertex> vertices;
+  for (const auto& prim : mesh.primitives) {
+    const std::vector<float> pos = floats(g, prim.attributes.at("POSITION"));
+    const std::vector<float> weights = floats(g, prim.attributes.at("WEIGHTS_0"));
+    const tinygltf::Accessor& ja = g.accessors[static_cast<std::size_t>(prim.attributes.at("JOINTS_0"))];
+    ASSERT_EQ(ja.componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+    const tinygltf::BufferView& jv = g.bufferViews[static_cast<std::size_t>(ja.bufferView)];
+    std::vector<std::uint16_t> joints(4 * ja.count);
+    std::memcpy(joints.data(), g.buffers[0].data.data() + jv.byteOffset, joints.size() * 2);
+    ASSERT_EQ(joints.size() / 4, pos.size() / 3);
+    for (std::size_t v = 0; v < ja.count; v += 7) {  // every 7th vertex
+      ASSERT_EQ(weights[4 * v], 1.0f);
+      ASSERT_EQ(weights[4 * v + 1] + weights[4 * v + 2] + weights[4 * v + 3], 0.0f);
+      vertices.push_back({Eigen::Vector3d(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]), joints[4 * v]});
+    }
+  }
+  ASSERT_GT(vertices.size(), 200u);
+
+  // The bind pose: MuJoCo at the model's qpos0.
+  std::unique_ptr<mjData, void (*)(mjData*)> bind(mj_makeData(m), mj_deleteData);
+  mj_kinematics(m, bind.get());
+  std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m), mj_deleteData);
+  const Eigen::Vector3d offset(0.5, 0.0, -1.0);  // (0.5, 1, 0) in MuJoCo axes
+  double worst_bone = 0, worst_vertex = 0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    std::copy(frames[k].begin(), frames[k].end(), d->qpos);
+    mj_kinematics(m, d.get());
+    const NodePose pose = pose_at(g, k);
+    std::vector<Eigen::Matrix4d> skinning;  // joint world transform times inverse bind matrix
+    for (std::size_t j = 0; j < skin.joints.size(); ++j)
+      skinning.push_back(world_of(pose, skin.joints[j]).matrix() * ibm[j]);
+    for (int b = 1; b < m->nbody; ++b) {
+      const Eigen::Matrix4d& s = skinning[static_cast<std::size_t>(b - 1)];
+      // The bone's origin at the bind pose, moved by its joint.
+      const Eigen::Vector3d origin = to_gltf(Eigen::Map<const Eigen::Vector3d>(bind->xpos + 3 * b));
+      const Eigen::Vector3d moved = (s * origin.homogeneous()).head<3>();
+      const Eigen::Vector3d expected = to_gltf(Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * b)) + offset;
+      worst_bone = std::max(worst_bone, (moved - expected).norm());
+    }
+    for (const Vertex& v : vertices) {
+      const int b = v.joint + 1;
+      // The vertex in its body's frame (MuJoCo axes), then where the body is at frame k.
+      const Eigen::Vector3d bind_mj(v.bind[0], -v.bind[2], v.bind[1]);
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r0(bind->xmat + 9 * b), rk(d->xmat + 9 * b);
+      const Eigen::Vector3d local = r0.transpose() * (bind_mj - Eigen::Map<const Eigen::Vector3d>(bind->xpos + 3 * b));
+      const Eigen::Vector3d expected = to_gltf(rk * local + Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * b)) + offset;
+      const Eigen::Vector3d moved = (skinning[static_cast<std::size_t>(v.joint)] * v.bind.homogeneous()).head<3>();
+      worst_vertex = std::max(worst_vertex, (moved - expected).norm());
+    }
+  }
+  EXPECT_LT(worst_bone, 1e-5) << "m";
+  EXPECT_LT(worst_vertex, 1e-5) << "m";
+}
+
+// The planar human's joints carry the humanoid names of its own bodies (abdomen, chest,
+// neck), and a robot gets none.
+TEST(GltfSkin, HumanoidNamesOnlyOnHumans) {
+  for (const char* name : {"human2d", "robot3d"}) {
+    const auto model = SharedModel::from_file(std::string(DIVERSE_SOURCE_DIR) + "/assets/characters/" + name + ".xml");
+    const mjModel* m = model->get();
+    const fs::path file = temp_dir() / (std::string(name) + "_names.glb");
+    write_glb(file, {GltfMotion{m, {std::vector<double>(m->qpos0, m->qpos0 + m->nq)}, "M0", {0, 0, 0}}});
+    const tinygltf::Model g = read_glb(file);
+    std::map<std::string, std::string> humanoid;
+    for (const auto& node : g.nodes)
+      if (node.extras.Has("humanoid_bone")) humanoid[node.name] = node.extras.Get("humanoid_bone").Get<std::string>();
+    if (std::string(name) == "human2d") {
+      EXPECT_EQ(humanoid.size(), 17u);
+      EXPECT_EQ(humanoid["chest"], "Chest");
+      EXPECT_EQ(humanoid["neck"], "Neck");
+      EXPECT_EQ(humanoid["shin_r"], "RightLowerLeg");
+    } else {
+      EXPECT_TRUE(humanoid.empty());
+    }
+    ASSERT_EQ(g.skins.size(), 1u);
+    EXPECT_EQ(g.skins[0].joints.size(), static_cast<std::size_t>(m->nbody - 1));
+  }
+}
+
 TEST(GltfExport, Human3dPushedSidewaysMatchesMujoco) {
   const auto motion = test_support::stance_motion("human3d", {0.2, 0.3, 0.0}, 1.5);
   const mjModel* m = motion.model->get();
   const auto frames = recorded_frames(motion.record, 17);
   const fs::path file = temp_dir() / "human3d.glb";
-  write_glb(file, {GltfMotion{m, frames, "M0", {0, 0, 0}}});
+  write_glb(file, {GltfMotion{m, frames, "M0", {0, 0, 0}}}, rigid());
   const tinygltf::Model g = read_glb(file);
   ASSERT_EQ(g.nodes.size(), static_cast<std::size_t>(m->nbody));  // the motion's node + bodies
   EXPECT_EQ(g.nodes[0].name, "M0");
@@ -180,7 +341,7 @@ TEST(GltfExport, SideBySideMotionsKeepTheirOwnBodies) {
                                   {bird.model->get(), bf, "M1", {0, -2.0, 0}}};
   EXPECT_GT(side_by_side_spacing(motions), 0.5);
   const fs::path file = temp_dir() / "both.glb";
-  write_glb(file, motions);
+  write_glb(file, motions, rigid());
   const tinygltf::Model g = read_glb(file);
   ASSERT_EQ(g.scenes.size(), 1u);
   ASSERT_EQ(g.scenes[0].nodes.size(), 2u);
@@ -233,7 +394,7 @@ TEST(GltfExport, ShapedBodiesKeepTheirProportions) {
   const std::vector<std::vector<double>> fb{std::vector<double>(mb->qpos0, mb->qpos0 + mb->nq)};
   const std::vector<std::vector<double>> fs{std::vector<double>(ms->qpos0, ms->qpos0 + ms->nq)};
   const fs::path file = temp_dir() / "shaped.glb";
-  write_glb(file, {GltfMotion{mb, fb, "M0", {0, 0, 0}}, GltfMotion{ms, fs, "M1", {0, 0, 0}}});
+  write_glb(file, {GltfMotion{mb, fb, "M0", {0, 0, 0}}, GltfMotion{ms, fs, "M1", {0, 0, 0}}}, rigid());
   const tinygltf::Model g = read_glb(file);
   auto thigh_extent = [&](const std::string& node_name) {
     for (const auto& node : g.nodes) {
