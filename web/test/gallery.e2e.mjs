@@ -13,9 +13,9 @@
 // heatmap per metric with a cell per pair. A run with bounds shows every motion's effort
 // relative to M0's, marked where over the bound, and its bounds. A 3D run (free root) is seen three-quarters and
 // its "follow" switch moves the views. Where RUN_DIR/export holds glTF files: every .glb
-// passes the Khronos glTF validator with no error, three.js's GLTFLoader reads each with a
-// node per body and its animation, and playing it puts every body within 1 mm of MuJoCo's
-// positions; all.glb is drawn in Chromium by a small three.js viewer (its pixels are not
+// passes the Khronos glTF validator with no error, three.js's GLTFLoader reads each as a
+// SkinnedMesh with a bone per body and its animation, and playing it with an AnimationMixer
+// puts every bone and a vertex of each within 1 mm of MuJoCo's bodies; all.glb is drawn in Chromium by a small three.js viewer (its pixels are not
 // uniform). With blends (`diverse blend`): one blend tile and one weight slider per motion;
 // for every blend, its own weights on the sliders bring up the blend nearest to them (as
 // the test computes it), marked as meeting the task or not as its constraint says; two
@@ -445,7 +445,7 @@ try {
     }
     // Each motion's file in three.js: a node per body, its animation played back against
     // MuJoCo's body positions (glTF axes: (x, z, -y) of MuJoCo's).
-    let worstGltf = 0;
+    let worstGltf = 0, worstSkin = 0, skinnedChecks = 0;
     for (const [i, motion] of data.motions.entries()) {
       const bytes = readFileSync(join(exportDir, `m${i}.glb`));
       const gltf = await new Promise((ok, fail) => new GLTFLoader().parse(
@@ -456,6 +456,19 @@ try {
       const missing = model.bodies.filter((b) => !byName.has(b.name.replace(/[.\s]/g, '_')) && !byName.has(b.name));
       check(missing.length === 0, `GLTFLoader: ${motion.label} has a node per body`, missing.map((b) => b.name).join(' '));
       check(gltf.animations.length === 1, `GLTFLoader: ${motion.label} has its animation`);
+      // The character is one SkinnedMesh over a bone per body (the skin's joints in body order).
+      let skinned = null;
+      gltf.scene.traverse((o) => { if (o.isSkinnedMesh) skinned = o; });
+      check(skinned !== null && skinned.skeleton.bones.length === model.bodies.length &&
+            skinned.skeleton.bones.every((bone, b) => bone.name === byName.get(model.bodies[b].name)?.name),
+            `GLTFLoader: ${motion.label} is a SkinnedMesh with a bone per body`,
+            skinned ? skinned.skeleton.bones.map((bone) => bone.name).join(' ') : 'none');
+      // One vertex bound to each bone.
+      const vertexOf = new Map();
+      if (skinned) {
+        const index = skinned.geometry.attributes.skinIndex;
+        for (let v = 0; v < index.count; v++) if (!vertexOf.has(index.getX(v))) vertexOf.set(index.getX(v), v);
+      }
       const mixer = new THREE.AnimationMixer(gltf.scene);
       const clip = gltf.animations[0];
       mixer.clipAction(clip).setLoop(THREE.LoopOnce, 1).play().clampWhenFinished = true;
@@ -470,10 +483,25 @@ try {
           const o = (k * motion.frames.bodies + b) * 7;
           const d = motion.frames.data;
           worstGltf = Math.max(worstGltf, p.distanceTo(new THREE.Vector3(d[o], d[o + 2], -d[o + 1])));
+          // The skinned vertex, as three.js deforms it, against the body's pose in MuJoCo
+          // applied to the vertex's place in its body (its bind position through the bone's
+          // inverse bind matrix).
+          const v = vertexOf.get(b);
+          if (skinned && v !== undefined) {
+            const bind = new THREE.Vector3().fromBufferAttribute(skinned.geometry.attributes.position, v);
+            const drawn = skinned.applyBoneTransform(v, bind.clone());
+            const body = new THREE.Matrix4().compose(new THREE.Vector3(d[o], d[o + 2], -d[o + 1]),
+              new THREE.Quaternion(d[o + 4], d[o + 6], -d[o + 5], d[o + 3]).normalize(), new THREE.Vector3(1, 1, 1));
+            const expected = bind.clone().applyMatrix4(skinned.skeleton.boneInverses[b]).applyMatrix4(body);
+            worstSkin = Math.max(worstSkin, drawn.distanceTo(expected));
+            skinnedChecks++;
+          }
         });
       }
     }
     check(worstGltf < 1e-3, 'GLTFLoader: bodies within 1 mm of MuJoCo\'s positions', `worst ${(worstGltf * 1000).toFixed(3)} mm`);
+    check(skinnedChecks > 0 && worstSkin < 1e-3, 'AnimationMixer: the SkinnedMesh\'s vertices within 1 mm of MuJoCo\'s bodies',
+      `${skinnedChecks} vertices, worst ${(worstSkin * 1000).toFixed(3)} mm`);
 
     // all.glb in a small three.js viewer page, in Chromium.
     const here = dirname(fileURLToPath(import.meta.url));
