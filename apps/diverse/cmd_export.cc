@@ -1,8 +1,8 @@
 // `diverse export RUN --bvh --gltf [--fps 30|60]`: every motion of a finished run for
 // animation and 3D tools: RUN/export/m<i>.bvh (a skeleton and its channels, io/bvh.h) and
-// RUN/export/m<i>.glb (glTF 2.0: the bodies' own meshes and colours, animated, io/gltf.h),
-// plus RUN/export/all.glb with every motion side by side. Metres, Y up; see
-// docs/guide/viewing-results.md for Blender's import settings.
+// RUN/export/m<i>.glb (glTF 2.0: a skinned character, a bone per body with the bodies' own
+// meshes and colours, animated, io/gltf.h), plus RUN/export/all.glb with every motion side
+// by side. Metres, Y up; see docs/guide/engines.md for Blender and game engines.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -35,8 +35,8 @@ void install(CLI::App& app) {
   cmd->add_option("run", args->run, "Run directory written by `diverse run`")->required();
   cmd->add_flag("--bvh", args->bvh, "BVH files (RUN/export/m<i>.bvh), metres, Y up");
   cmd->add_flag("--gltf", args->gltf,
-                "glTF 2.0 binary files (RUN/export/m<i>.glb and all.glb, every motion side by side), "
-                "metres, Y up");
+                "glTF 2.0 binary files of skinned characters, a bone per body (RUN/export/m<i>.glb "
+                "and all.glb, every motion side by side), metres, Y up");
   cmd->add_option("--fps", args->fps, "Frames per second: 30 or 60")->capture_default_str();
   cmd->callback([args] {
     if (!args->bvh && !args->gltf) throw UserError("export: choose a format: --bvh, --gltf or both");
