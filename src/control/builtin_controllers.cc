@@ -6,6 +6,7 @@
 #include "control/controller.h"
 #include "control/jump3d_controller.h"
 #include "control/jump_controller.h"
+#include "control/skill_controller.h"
 #include "control/walk_controller.h"
 
 namespace diverse {
@@ -15,6 +16,7 @@ std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   types.push_back(std::make_unique<JumpControllerType>());
   types.push_back(std::make_unique<Jump3dControllerType>());
   types.push_back(std::make_unique<WalkControllerType>());
+  types.push_back(std::make_unique<SkillControllerType>());
   return types;
 }
 

@@ -1,6 +1,8 @@
 // A strict reader of one TOML table, shared by every file format we parse (task files,
-// character files): unknown keys, wrong types, out-of-range or non-finite values and
-// missing fields are one-line UserErrors "FILE: FIELD: expected ...".
+// character files, skill files): unknown keys, wrong types, out-of-range or non-finite
+// values and missing fields are one-line UserErrors "FILE: FIELD: expected ...", or
+// "FILE: line N: FIELD: expected ..." from a reader made with_lines() (N the line of the
+// key, or of its table when the key is missing).
 #pragma once
 
 #include <cmath>
@@ -43,7 +45,16 @@ class TomlReader {
   bool has(const char* key) const { return table_.contains(key); }
 
   [[noreturn]] void fail(const std::string& key, const std::string& expectation) const {
-    throw_field_error(file_, field(key), expectation);
+    if (!lines_) throw_field_error(file_, field(key), expectation);
+    const toml::node* n = table_.get(key);
+    const auto line = (n != nullptr ? n->source() : table_.source()).begin.line;
+    throw_field_error(file_ + ": line " + std::to_string(line), field(key), expectation);
+  }
+  // The same reader, naming the line in its messages (and its sub-readers').
+  TomlReader with_lines() const {
+    TomlReader r = *this;
+    r.lines_ = true;
+    return r;
   }
   std::string field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
@@ -138,9 +149,15 @@ class TomlReader {
   }
   // A reader of entry `index` of an array of tables, named "key[index]" in messages.
   TomlReader element(const char* key, size_t index, const toml::table& t) const {
-    return TomlReader(file_, t, field(key) + "[" + std::to_string(index) + "]");
+    TomlReader r(file_, t, field(key) + "[" + std::to_string(index) + "]");
+    r.lines_ = lines_;
+    return r;
   }
-  TomlReader sub(const char* key, const toml::table& t) const { return TomlReader(file_, t, field(key)); }
+  TomlReader sub(const char* key, const toml::table& t) const {
+    TomlReader r(file_, t, field(key));
+    r.lines_ = lines_;
+    return r;
+  }
   const toml::table& raw() const { return table_; }
   const std::string& file() const { return file_; }
 
@@ -148,6 +165,7 @@ class TomlReader {
   std::string file_;
   const toml::table& table_;
   std::string path_;
+  bool lines_ = false;
 };
 
 // Parses a TOML file; UserError "PATH: cannot read the WHAT file (REASON)" or "PATH: line N:

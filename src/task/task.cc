@@ -32,7 +32,8 @@ std::string existing_file(const TomlReader& r, const char* key) {
 }
 
 void read_controller(const TomlReader& r, Task& task) {
-  task.controller = r.string("type");
+  // A skill file names the skill engine ("skill"); otherwise a controller type by name.
+  task.controller = r.has("skill") && !r.has("type") ? "skill" : r.string("type");
   task.controller_type = &find_controller(task.controller, r.file() + ": " + r.field("type"));
   task.controller_config = task.controller_type->read_config(r);
 }

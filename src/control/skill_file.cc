@@ -1,0 +1,646 @@
+#include "control/skill_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "core/error.h"
+#include "core/toml_reader.h"
+
+namespace diverse {
+namespace {
+
+int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+
+// A number node as double; false when it is not a number.
+bool as_number(const toml::node& n, double* v) {
+  if (auto f = n.as_floating_point()) {
+    *v = f->get();
+  } else if (auto i = n.as_integer()) {
+    *v = static_cast<double>(i->get());
+  } else if (auto b = n.as_boolean()) {
+    *v = b->get() ? 1.0 : 0.0;
+  } else {
+    return false;
+  }
+  return std::isfinite(*v);
+}
+
+constexpr const char* kValueForms =
+    "expected a number, { param = \"NAME\", range = [LOWER, UPPER] } or { curve = [[s, value], ...] }";
+
+// `range = [lower, upper]`, lower < upper.
+void read_range(const TomlReader& r, SkillValue& v) {
+  const toml::node* n = r.raw().get("range");
+  if (n == nullptr) return;
+  const toml::array* a = n->as_array();
+  double lo = 0, hi = 0;
+  if (a == nullptr || a->size() != 2 || !as_number(*a->get(0), &lo) || !as_number(*a->get(1), &hi)) {
+    r.fail("range", "expected [LOWER, UPPER], two numbers");
+  }
+  if (!(lo < hi)) r.fail("range", "expected a range that is not empty (LOWER < UPPER), got [" + num(lo) + ", " + num(hi) + "]");
+  v.has_range = true;
+  v.lower = lo;
+  v.upper = hi;
+}
+
+// A value: a number, or a table with exactly one of param, value, curve (`extra` keys
+// are the caller's: world, left, right).
+SkillValue read_value(const TomlReader& parent, const std::string& key, const toml::node& n,
+                      std::initializer_list<const char*> extra = {}) {
+  SkillValue v;
+  v.line = line_of(n);
+  if (as_number(n, &v.number)) return v;
+  const toml::table* t = n.as_table();
+  if (t == nullptr) parent.fail(key, kValueForms);
+  const TomlReader r = parent.sub(key.c_str(), *t);
+  std::vector<const char*> known = {"param", "value", "curve", "range", "unit"};
+  known.insert(known.end(), extra.begin(), extra.end());
+  for (const auto& [k, node] : *t) {
+    if (std::find_if(known.begin(), known.end(), [&](const char* s) { return k.str() == s; }) == known.end()) {
+      std::string list;
+      for (const char* s : known) list += std::string(list.empty() ? "" : ", ") + s;
+      r.fail(std::string(k.str()), "expected no such key (unknown key; known keys: " + list + ")");
+    }
+  }
+  const int forms = (r.has("param") ? 1 : 0) + (r.has("value") ? 1 : 0) + (r.has("curve") ? 1 : 0);
+  if (forms != 1) {
+    // left/right tables carry their values themselves.
+    if (forms == 0 && (r.has("left") || r.has("right"))) return v;
+    parent.fail(key, std::string(kValueForms) + (forms == 0 ? " (none given)" : " (only one of param, value, curve)"));
+  }
+  if (r.has("param")) {
+    v.kind = SkillValue::Kind::kParam;
+    v.param = r.string("param");
+    if (v.param.empty()) r.fail("param", "expected a parameter name");
+    read_range(r, v);
+    v.unit = r.string("unit", "");
+  } else if (r.has("value")) {
+    if (!as_number(*t->get("value"), &v.number)) r.fail("value", "expected a number");
+  } else {
+    v.kind = SkillValue::Kind::kCurve;
+    const toml::array* a = t->get("curve")->as_array();
+    const std::string expect = "expected knots [[s, value], ...] with s rising from 0 to 1";
+    if (a == nullptr || a->size() < 2) r.fail("curve", expect);
+    for (const toml::node& k : *a) {
+      const toml::array* knot = k.as_array();
+      double s = 0, y = 0;
+      if (knot == nullptr || knot->size() != 2 || !as_number(*knot->get(0), &s) || !as_number(*knot->get(1), &y)) {
+        r.fail("curve", expect);
+      }
+      if (!v.curve.empty() && !(s > v.curve.back()[0])) r.fail("curve", expect + ", got s = " + num(s) + " after " + num(v.curve.back()[0]));
+      v.curve.push_back({s, y});
+    }
+    if (v.curve.front()[0] != 0 || v.curve.back()[0] != 1) r.fail("curve", expect);
+  }
+  return v;
+}
+
+void read_target_set(const TomlReader& sets, const std::string& name, const toml::table& t,
+                     std::vector<SkillTarget>& out) {
+  const TomlReader r = sets.sub(name.c_str(), t);
+  for (const auto& [k, node] : t) {
+    SkillTarget target;
+    target.selector = std::string(k.str());
+    target.line = line_of(node);
+    target.both = read_value(r, target.selector, node, {"world", "left", "right"});
+    if (const toml::table* e = node.as_table()) {
+      const TomlReader er = r.sub(target.selector.c_str(), *e);
+      const std::string world = er.string("world", "joint");
+      if (world == "parent") target.world = SkillTarget::World::kParent;
+      else if (world == "child") target.world = SkillTarget::World::kChild;
+      else if (world != "joint") er.fail("world", "expected \"joint\", \"parent\" or \"child\", got \"" + world + "\"");
+      if (er.has("left") || er.has("right")) {
+        if (er.has("param") || er.has("value") || er.has("curve")) {
+          er.fail("left", "expected either one value for both sides or left and right, not both");
+        }
+        if (!er.has("left") || !er.has("right")) er.fail(er.has("left") ? "right" : "left", "expected both left and right (missing)");
+        target.sided = true;
+        target.left = read_value(er, "left", *e->get("left"));
+        target.right = read_value(er, "right", *e->get("right"));
+      }
+    }
+    out.push_back(target);
+  }
+}
+
+void read_gain_set(const TomlReader& sets, const std::string& name, const toml::table& t, std::vector<SkillGain>& out) {
+  const TomlReader r = sets.sub(name.c_str(), t);
+  for (const auto& [k, node] : t) {
+    const std::string selector(k.str());
+    const toml::table* e = node.as_table();
+    if (e == nullptr) r.fail(selector, "expected a table { kp = ..., kd = ... }");
+    const TomlReader er = r.sub(selector.c_str(), *e);
+    er.only({"kp", "kd"});
+    if (!er.has("kp") || !er.has("kd")) er.fail(er.has("kp") ? "kd" : "kp", std::string(kValueForms) + " (missing)");
+    SkillGain g;
+    g.selector = selector;
+    g.line = line_of(node);
+    g.kp = read_value(er, "kp", *e->get("kp"));
+    g.kd = read_value(er, "kd", *e->get("kd"));
+    for (const SkillValue* v : {&g.kp, &g.kd}) {
+      if (v->kind == SkillValue::Kind::kCurve) er.fail(v == &g.kp ? "kp" : "kd", "expected a number or a parameter (gains take no curve)");
+      if (v->kind == SkillValue::Kind::kParam && !v->has_range) er.fail(v == &g.kp ? "kp" : "kd", "expected a range = [LOWER, UPPER] for a gain parameter");
+    }
+    out.push_back(g);
+  }
+}
+
+const std::vector<std::string> kConditions = {"duration", "time",         "contact",      "touchdown",
+                                              "liftoff",  "contact_made", "contact_lost", "peak",
+                                              "turned",   "spotted",      "feature"};
+const std::vector<std::string> kFeatures = {"com_x", "com_z", "com_vx", "com_vz", "pitch", "pitch_rate"};
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += std::string(s.empty() ? "\"" : ", \"") + n + "\"";
+  return s;
+}
+
+SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
+  r.only({"to", "on", "passes", "gave_up", "after", "for", "angle", "body", "feature", "above", "below"});
+  SkillTransition tr;
+  tr.line = line_of(t);
+  tr.to = r.string("to");
+  std::vector<std::string> kinds;
+  if (const toml::node* on = t.get("on"); on != nullptr && on->is_string()) {
+    kinds.push_back(r.string("on"));
+  } else {
+    kinds = r.strings("on", 1);
+  }
+  tr.gave_up = r.boolean("gave_up", false);
+  if (r.has("passes")) tr.passes = r.strings("passes");
+  std::set<std::string> used;
+  for (const std::string& kind : kinds) {
+    if (std::find(kConditions.begin(), kConditions.end(), kind) == kConditions.end()) {
+      r.fail("on", "expected one of " + quoted_list(kConditions) + ", got \"" + kind + "\"");
+    }
+    SkillCondition c;
+    c.kind = kind;
+    auto need = [&](const char* key) {
+      if (!r.has(key)) r.fail(key, "expected a setting for the \"" + kind + "\" condition (missing)");
+      used.insert(key);
+    };
+    if (kind == "time") {
+      need("after");
+      c.after = r.number("after", 0, 100);
+    } else if (kind == "liftoff") {
+      c.airborne = r.number("for", 0, 1, c.airborne);
+      used.insert("for");
+    } else if (kind == "turned") {
+      need("angle");
+      c.angle = r.number("angle", 0, 8 * M_PI);
+    } else if (kind == "contact_made" || kind == "contact_lost") {
+      need("body");
+      c.body = r.string("body");
+    } else if (kind == "feature") {
+      need("feature");
+      c.feature = r.string("feature");
+      if (std::find(kFeatures.begin(), kFeatures.end(), c.feature) == kFeatures.end()) {
+        r.fail("feature", "expected one of " + quoted_list(kFeatures) + ", got \"" + c.feature + "\"");
+      }
+      if (r.has("above") == r.has("below")) r.fail("above", "expected exactly one of above = NUMBER or below = NUMBER");
+      c.above = r.has("above");
+      c.threshold = r.number(c.above ? "above" : "below", -1e6, 1e6);
+      used.insert(c.above ? "above" : "below");
+    }
+    tr.on.push_back(c);
+  }
+  for (const char* key : {"after", "for", "angle", "body", "feature", "above", "below"}) {
+    if (r.has(key) && used.count(key) == 0) r.fail(key, "expected no such setting for the conditions " + quoted_list(kinds));
+  }
+  return tr;
+}
+
+SkillDuration read_duration(const TomlReader& r, const toml::table& phase) {
+  SkillDuration d;
+  const toml::node* n = phase.get("duration");
+  if (n == nullptr) return d;
+  d.line = line_of(*n);
+  const toml::table* t = n->as_table();
+  if (t != nullptr && t->contains("predict")) {
+    const TomlReader pr = r.sub("duration", *t);
+    pr.only({"predict", "at_most"});
+    d.kind = SkillDuration::Kind::kPredict;
+    d.predict = pr.string("predict");
+    if (d.predict != "rise" && d.predict != "fall" && d.predict != "touchdown") {
+      pr.fail("predict", "expected \"rise\", \"fall\" or \"touchdown\", got \"" + d.predict + "\"");
+    }
+    d.at_most = pr.number("at_most", 0, 10, 0);
+    return d;
+  }
+  d.kind = SkillDuration::Kind::kValue;
+  d.value = read_value(r, "duration", *n);
+  if (d.value.kind == SkillValue::Kind::kCurve) r.fail("duration", "expected a number or a parameter (a duration takes no curve)");
+  if (d.value.kind == SkillValue::Kind::kParam && !d.value.has_range) r.fail("duration", "expected a range = [LOWER, UPPER] for a duration parameter");
+  if (d.value.kind == SkillValue::Kind::kNumber && !(d.value.number > 0)) r.fail("duration", "expected a duration > 0 s, got " + num(d.value.number));
+  return d;
+}
+
+}  // namespace
+
+const std::vector<SkillModuleKind>& skill_module_kinds() {
+  static const std::vector<SkillModuleKind> kinds = {
+      {"balance", {"kp", "kd", "max_force"}, {"gravity_compensation", "offset", "lean"},
+       "J^T balance: a virtual force on the COM through the stance legs (Pratt et al. 2001)"},
+      {"foot_placement", {"offset", "velocity_gain"}, {"reach", "at_touchdown"},
+       "landing: the hips place the ankles where the COM comes down (paper section 6)"},
+      {"spotting", {"turn", "open_time"}, {},
+       "spotting the landing: the `spotted` condition holds when the body, opened now, turns `turn` by touch-down"},
+      {"stance", {}, {"offset", "stand_after", "stand_duration"},
+       "stance control: COM force kept inside the soles, pelvis, chest and feet in world pitch"},
+  };
+  return kinds;
+}
+
+int SkillFile::phase_index(const std::string& n) const {
+  for (size_t i = 0; i < phases.size(); ++i)
+    if (phases[i].name == n) return static_cast<int>(i);
+  return -1;
+}
+
+int SkillFile::module_index(const std::string& n) const {
+  for (size_t i = 0; i < modules.size(); ++i)
+    if (modules[i].name == n) return static_cast<int>(i);
+  return -1;
+}
+
+SkillFile load_skill_file(const std::string& path) {
+  const toml::table root = parse_toml_file(path, "skill");
+  const TomlReader r = TomlReader(path, root, "").with_lines();
+  r.only({"name", "description", "root", "pairs", "events", "targets", "gains", "modules", "phases"});
+  SkillFile s;
+  s.file = path;
+  s.name = r.string("name");
+  s.description = r.string("description", "");
+  const std::string root_kind = r.string("root", "planar");
+  if (root_kind == "free") s.root = RootKind::kFree;
+  else if (root_kind != "planar") r.fail("root", "expected \"planar\" or \"free\", got \"" + root_kind + "\"");
+  if (r.has("pairs")) s.pairs = r.strings("pairs");
+
+  if (const toml::table* t = r.table("targets", true)) {
+    const TomlReader tr = r.sub("targets", *t);
+    for (const auto& [k, node] : *t) {
+      if (!node.is_table()) tr.fail(std::string(k.str()), "expected a table of targets [targets.NAME]");
+      read_target_set(tr, std::string(k.str()), *node.as_table(), s.target_sets[std::string(k.str())]);
+    }
+  }
+  if (const toml::table* t = r.table("gains", false)) {
+    const TomlReader gr = r.sub("gains", *t);
+    for (const auto& [k, node] : *t) {
+      if (!node.is_table()) gr.fail(std::string(k.str()), "expected a table of gains [gains.NAME]");
+      read_gain_set(gr, std::string(k.str()), *node.as_table(), s.gain_sets[std::string(k.str())]);
+    }
+  }
+
+  // Modules: a kind the engine knows, its required settings, no others.
+  const auto modules = r.tables("modules", false);
+  for (size_t i = 0; i < modules.size(); ++i) {
+    const TomlReader mr = r.element("modules", i, *modules[i]);
+    SkillModuleSpec m;
+    m.line = line_of(*modules[i]);
+    m.name = mr.string("name");
+    m.kind = mr.string("kind");
+    if (s.module_index(m.name) >= 0) mr.fail("name", "expected a name no other module has, got \"" + m.name + "\" twice");
+    const SkillModuleKind* kind = nullptr;
+    std::vector<std::string> kinds;
+    for (const SkillModuleKind& k : skill_module_kinds()) {
+      kinds.emplace_back(k.kind);
+      if (m.kind == k.kind) kind = &k;
+    }
+    if (kind == nullptr) mr.fail("kind", "expected one of " + quoted_list(kinds) + ", got \"" + m.kind + "\"");
+    for (const auto& [k, node] : *modules[i]) {
+      const std::string key(k.str());
+      if (key == "name" || key == "kind") continue;
+      const bool known = std::any_of(kind->required.begin(), kind->required.end(), [&](const char* x) { return key == x; }) ||
+                         std::any_of(kind->optional.begin(), kind->optional.end(), [&](const char* x) { return key == x; });
+      if (!known) {
+        std::string list;
+        for (const auto* group : {&kind->required, &kind->optional})
+          for (const char* x : *group) list += std::string(list.empty() ? "" : ", ") + x;
+        mr.fail(key, "expected no such setting for a \"" + m.kind + "\" module (known: " + list + ")");
+      }
+      SkillValue v = read_value(mr, key, node);
+      if (v.kind == SkillValue::Kind::kCurve) mr.fail(key, "expected a number or a parameter (a setting takes no curve)");
+      if (v.kind == SkillValue::Kind::kParam && !v.has_range) mr.fail(key, "expected a range = [LOWER, UPPER] for a module parameter");
+      m.settings[key] = v;
+    }
+    for (const char* key : kind->required) {
+      if (m.settings.count(key) == 0) mr.fail(key, "expected a setting of the \"" + m.kind + "\" module (missing)");
+    }
+    s.modules.push_back(m);
+  }
+
+  // Phases.
+  const auto phases = r.tables("phases", true);
+  if (phases.empty()) r.fail("phases", "expected at least one [[phases]]");
+  std::vector<TomlReader> readers;
+  for (size_t i = 0; i < phases.size(); ++i) {
+    readers.push_back(r.element("phases", i, *phases[i]));
+    const TomlReader& pr = readers.back();
+    pr.only({"name", "targets", "gains", "duration", "interpolate", "modules", "next"});
+    SkillPhase p;
+    p.line = line_of(*phases[i]);
+    p.name = pr.string("name");
+    if (s.phase_index(p.name) >= 0) pr.fail("name", "expected a name no other phase has, got \"" + p.name + "\" twice");
+    p.targets = pr.string("targets");
+    if (s.target_sets.count(p.targets) == 0) pr.fail("targets", "expected a target set [targets." + p.targets + "] (none in the file)");
+    p.gains = pr.string("gains", "");
+    if (!p.gains.empty() && s.gain_sets.count(p.gains) == 0) pr.fail("gains", "expected a gain set [gains." + p.gains + "] (none in the file)");
+    p.interpolate = pr.boolean("interpolate", true);
+    p.duration = read_duration(pr, *phases[i]);
+    if (pr.has("modules")) p.modules = pr.strings("modules");
+    for (const std::string& m : p.modules) {
+      if (s.module_index(m) < 0) pr.fail("modules", "expected modules the file declares in [[modules]], got \"" + m + "\"");
+    }
+    for (const toml::table* t : pr.tables("next", false)) {
+      p.next.push_back(read_transition(pr.element("next", p.next.size(), *t), *t));
+    }
+    s.phases.push_back(p);
+  }
+
+  // Transitions lead to phases that exist; every phase but the last can be left.
+  for (size_t i = 0; i < s.phases.size(); ++i) {
+    const SkillPhase& p = s.phases[i];
+    const TomlReader& pr = readers[i];
+    for (size_t k = 0; k < p.next.size(); ++k) {
+      const SkillTransition& tr = p.next[k];
+      const auto& elements = pr.tables("next", false);
+      const TomlReader er = pr.element("next", k, *elements[k]);
+      if (s.phase_index(tr.to) < 0) er.fail("to", "expected the name of a phase, got \"" + tr.to + "\" (no such phase)");
+      for (const std::string& passed : tr.passes) {
+        if (s.phase_index(passed) < 0) er.fail("passes", "expected names of phases, got \"" + passed + "\" (no such phase)");
+      }
+      for (const SkillCondition& c : tr.on) {
+        if (c.kind == "duration" && p.duration.kind != SkillDuration::Kind::kValue &&
+            p.duration.kind != SkillDuration::Kind::kPredict) {
+          er.fail("on", "expected the phase to have a duration for an \"duration\" transition (phase \"" + p.name + "\" has none)");
+        }
+        if (c.kind == "spotted" &&
+            std::none_of(p.modules.begin(), p.modules.end(), [&](const std::string& m) { return s.modules[static_cast<size_t>(s.module_index(m))].kind == "spotting"; })) {
+          er.fail("on", "expected the phase to switch on a \"spotting\" module for a \"spotted\" transition");
+        }
+      }
+    }
+    if (p.next.empty() && i + 1 != s.phases.size()) {
+      pr.fail("next", "expected at least one transition: phase \"" + p.name + "\" can never be left (only the last phase may end the skill)");
+    }
+  }
+
+  // Events name phases.
+  if (const toml::table* t = r.table("events", false)) {
+    const TomlReader er = r.sub("events", *t);
+    er.only({"push", "takeoff", "peak", "landing", "film_strip"});
+    for (auto [key, field] : {std::pair{"push", &s.push}, {"takeoff", &s.takeoff}, {"peak", &s.peak}, {"landing", &s.landing}}) {
+      *field = er.string(key, "");
+      if (!field->empty() && s.phase_index(*field) < 0) er.fail(key, "expected the name of a phase, got \"" + *field + "\" (no such phase)");
+    }
+    if (er.has("film_strip")) {
+      s.film_strip = er.strings("film_strip");
+      for (const std::string& e : s.film_strip) {
+        const std::string* phase = e == "push" ? &s.push : e == "takeoff" ? &s.takeoff : e == "peak" ? &s.peak : e == "landing" ? &s.landing : nullptr;
+        if (phase == nullptr) er.fail("film_strip", "expected events among \"push\", \"takeoff\", \"peak\", \"landing\", got \"" + e + "\"");
+        if (phase->empty()) er.fail("film_strip", "expected events [events] names a phase for, got \"" + e + "\"");
+      }
+    }
+  }
+  return s;
+}
+
+void override_skill_settings(SkillFile& skill, const TomlReader& r, const std::vector<std::string>& own_keys) {
+  for (const auto& [k, node] : r.raw()) {
+    const std::string key(k.str());
+    if (std::find(own_keys.begin(), own_keys.end(), key) != own_keys.end()) continue;
+    const int m = skill.module_index(key);
+    if (m < 0 || !node.is_table()) {
+      std::string known;
+      for (const auto& own : own_keys) known += std::string(known.empty() ? "" : ", ") + own;
+      for (const auto& mod : skill.modules) known += ", " + mod.name;
+      r.fail(key, "expected no such key (unknown key; known keys: " + known + ", the last the skill's modules as tables)");
+    }
+    SkillModuleSpec& spec = skill.modules[static_cast<size_t>(m)];
+    const TomlReader mr = r.sub(key.c_str(), *node.as_table());
+    for (const auto& [sk, sn] : *node.as_table()) {
+      const std::string setting(sk.str());
+      auto it = spec.settings.find(setting);
+      const SkillModuleKind* kind = nullptr;
+      for (const SkillModuleKind& x : skill_module_kinds())
+        if (spec.kind == x.kind) kind = &x;
+      const bool known = std::any_of(kind->required.begin(), kind->required.end(), [&](const char* x) { return setting == x; }) ||
+                         std::any_of(kind->optional.begin(), kind->optional.end(), [&](const char* x) { return setting == x; });
+      if (!known) mr.fail(setting, "expected a setting of the \"" + spec.kind + "\" module " + key);
+      if (it != spec.settings.end() && it->second.kind == SkillValue::Kind::kParam) {
+        mr.fail(setting, "expected a number setting (the skill makes " + key + "." + setting + " the parameter \"" + it->second.param + "\")");
+      }
+      double v = 0;
+      if (!as_number(sn, &v)) mr.fail(setting, "expected a number");
+      SkillValue value;
+      value.number = v;
+      value.line = line_of(sn);
+      spec.settings[setting] = value;
+    }
+  }
+}
+
+std::vector<int> select_groups(const std::string& selector, const Character& body) {
+  // A group of that name, and every group of that role (a name may be both: "neck").
+  std::vector<int> out;
+  const int named = body.find_group(selector);
+  if (named >= 0) out.push_back(named);
+  std::string role = selector;
+  const bool top = selector.size() > 4 && selector.compare(selector.size() - 4, 4, ".top") == 0;
+  if (top) role = selector.substr(0, selector.size() - 4);
+  size_t depth = 0;
+  for (size_t g = 0; g < body.groups.size(); ++g) {
+    if (role != to_string(body.groups[g].role)) continue;
+    if (!top) {
+      if (static_cast<int>(g) != named) out.push_back(static_cast<int>(g));
+      continue;
+    }
+    // The topmost: the group whose joint has the longest chain from the root.
+    const size_t d = body.chain(body.groups[g].joints[0]).size();
+    if (out.empty() || d > depth) {
+      out = {static_cast<int>(g)};
+      depth = d;
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// The parameter list being built: a name used twice is one parameter.
+int add_param(std::vector<ParamSpec>& params, const ParamSpec& spec, const std::string& file, int line,
+              const std::string& field) {
+  for (size_t i = 0; i < params.size(); ++i) {
+    if (params[i].name != spec.name) continue;
+    if (params[i].lower != spec.lower || params[i].upper != spec.upper) {
+      throw_field_error(file + ": line " + std::to_string(line), field,
+                        "expected the range of \"" + spec.name + "\" given before, [" + num(params[i].lower) + ", " +
+                            num(params[i].upper) + "], got [" + num(spec.lower) + ", " + num(spec.upper) + "]");
+    }
+    return static_cast<int>(i);
+  }
+  params.push_back(spec);
+  return static_cast<int>(params.size() - 1);
+}
+
+std::string replace_group(std::string name, const std::string& group) {
+  const std::string key = "{group}";
+  for (size_t at = name.find(key); at != std::string::npos; at = name.find(key)) name.replace(at, key.size(), group);
+  return name;
+}
+
+}  // namespace
+
+SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjModel* m) {
+  const std::string& file = skill.file;
+  auto fail = [&](int line, const std::string& field, const std::string& expectation) {
+    throw_field_error(file + ": line " + std::to_string(line), field, expectation);
+  };
+  const std::string who = "the character " + body.spec->file;
+  if (body.root != skill.root) {
+    fail(1, "root", std::string("expected a character with a ") + to_string(skill.root) + " root, but " + who + " has a " +
+                        to_string(body.root) + " root");
+  }
+  for (const std::string& role : skill.pairs) {
+    const auto groups = select_groups(role, body);
+    if (groups.empty()) fail(1, "pairs", "expected a joint group with role \"" + role + "\", but " + who + " has none");
+    if (body.groups[static_cast<size_t>(groups[0])].joints.size() != 2) {
+      fail(1, "pairs", "expected a left/right pair in the \"" + role + "\" group (two legs), in " + who);
+    }
+  }
+
+  SkillBinding b;
+  b.phases.resize(skill.phases.size());
+  // Targets and gains per phase, parameters in the documented order.
+  for (size_t p = 0; p < skill.phases.size(); ++p) {
+    const SkillPhase& phase = skill.phases[p];
+    SkillPhaseBinding& pb = b.phases[p];
+    pb.targets.assign(body.joints.size(), {});
+    pb.gains.assign(body.joints.size(), {});
+    const std::string prefix = phase.name + ".";
+    // Which entry of the set drives each group: named ones first, then "other".
+    const auto& set = skill.target_sets.at(phase.targets);
+    std::vector<const SkillTarget*> entry(body.groups.size(), nullptr);
+    const SkillTarget* other = nullptr;
+    for (const SkillTarget& t : set) {
+      if (t.selector == "other") {
+        other = &t;
+        continue;
+      }
+      const auto groups = select_groups(t.selector, body);
+      if (groups.empty()) {
+        fail(t.line, "targets." + phase.targets + "." + t.selector,
+             "expected a joint group, role or ROLE.top of " + who + ", got \"" + t.selector + "\" (it has none)");
+      }
+      for (int g : groups) {
+        // A group named by name wins over one picked by role.
+        if (entry[static_cast<size_t>(g)] == nullptr || t.selector == body.groups[static_cast<size_t>(g)].name) {
+          entry[static_cast<size_t>(g)] = &t;
+        }
+      }
+    }
+    for (size_t g = 0; g < body.groups.size(); ++g) {
+      const SkillTarget* t = entry[g] != nullptr ? entry[g] : other;
+      const JointGroup& group = body.groups[g];
+      if (t == nullptr) {
+        fail(phase.line, "phases." + phase.name + ".targets",
+             "expected a target for the group \"" + group.name + "\" in [targets." + phase.targets + "] (or an \"other\" entry)");
+      }
+      for (size_t side = 0; side < group.joints.size(); ++side) {
+        const int j = group.joints[side];
+        const SkillValue* v = &t->both;
+        if (t->sided) v = group.joints.size() == 2 && side == 1 ? &t->right : &t->left;
+        SkillJointTarget& jt = pb.targets[static_cast<size_t>(j)];
+        jt.world = t->world;
+        jt.value = v;
+        if (v->kind == SkillValue::Kind::kParam) {
+          const CharacterJoint& joint = body.joints[static_cast<size_t>(group.joints[0])];
+          ParamSpec spec{prefix + replace_group(v->param, group.name), v->lower, v->upper, v->unit.empty() ? "rad" : v->unit};
+          if (!v->has_range) {
+            spec.lower = std::isfinite(joint.lower) ? joint.lower : -M_PI;
+            spec.upper = std::isfinite(joint.upper) ? joint.upper : M_PI;
+          }
+          jt.param = add_param(b.params, spec, file, v->line, "targets." + phase.targets + "." + t->selector);
+        }
+      }
+    }
+    // Gains: the set's entries, the character's gains for the groups it does not name.
+    for (size_t j = 0; j < body.joints.size(); ++j) {
+      const JointGroup& group = body.groups[static_cast<size_t>(body.joints[j].group)];
+      pb.gains[j].kp = group.kp;
+      pb.gains[j].kd = group.kd;
+    }
+    if (!phase.gains.empty()) {
+      const auto& gains = skill.gain_sets.at(phase.gains);
+      std::vector<const SkillGain*> gentry(body.groups.size(), nullptr);
+      for (const SkillGain& g : gains) {
+        const auto groups = select_groups(g.selector, body);
+        if (groups.empty()) {
+          fail(g.line, "gains." + phase.gains + "." + g.selector,
+               "expected a joint group, role or ROLE.top of " + who + ", got \"" + g.selector + "\" (it has none)");
+        }
+        for (int k : groups) gentry[static_cast<size_t>(k)] = &g;
+      }
+      for (size_t g = 0; g < body.groups.size(); ++g) {
+        const SkillGain* e = gentry[g];
+        if (e == nullptr) continue;
+        int kp = -1, kd = -1;
+        for (auto [value, index] : {std::pair{&e->kp, &kp}, {&e->kd, &kd}}) {
+          if (value->kind != SkillValue::Kind::kParam) continue;
+          const ParamSpec spec{prefix + replace_group(value->param, body.groups[g].name), value->lower, value->upper,
+                               value->unit.empty() ? (value == &e->kp ? "Nm/rad" : "Nm s/rad") : value->unit};
+          *index = add_param(b.params, spec, file, value->line, "gains." + phase.gains + "." + e->selector);
+        }
+        for (int j : body.groups[g].joints) {
+          SkillJointGain& jg = b.phases[p].gains[static_cast<size_t>(j)];
+          jg.kp_param = kp;
+          jg.kd_param = kd;
+          if (kp < 0) jg.kp = e->kp.number;
+          if (kd < 0) jg.kd = e->kd.number;
+        }
+      }
+    }
+  }
+  // Durations, phase by phase.
+  for (size_t p = 0; p < skill.phases.size(); ++p) {
+    const SkillDuration& d = skill.phases[p].duration;
+    if (d.kind != SkillDuration::Kind::kValue || d.value.kind != SkillValue::Kind::kParam) continue;
+    const ParamSpec spec{skill.phases[p].name + "." + d.value.param, d.value.lower, d.value.upper,
+                         d.value.unit.empty() ? "s" : d.value.unit};
+    b.phases[p].duration_param = add_param(b.params, spec, file, d.value.line, "phases." + skill.phases[p].name + ".duration");
+  }
+  // Modules' parameters, module by module (full names).
+  b.module_params.resize(skill.modules.size());
+  for (size_t k = 0; k < skill.modules.size(); ++k) {
+    for (const auto& [name, value] : skill.modules[k].settings) {
+      int index = -1;
+      if (value.kind == SkillValue::Kind::kParam) {
+        index = add_param(b.params, {value.param, value.lower, value.upper, value.unit}, file, value.line,
+                          "modules." + skill.modules[k].name + "." + name);
+      }
+      b.module_params[k][name] = index;
+    }
+  }
+  for (size_t p = 0; p < skill.phases.size(); ++p) {
+    for (const std::string& mod : skill.phases[p].modules) b.phases[p].modules.push_back(skill.module_index(mod));
+  }
+  // Bodies the transitions name.
+  if (m != nullptr) {
+    for (const SkillPhase& phase : skill.phases) {
+      for (const SkillTransition& tr : phase.next) {
+        for (const SkillCondition& c : tr.on) {
+          if (c.body.empty()) continue;
+          const int id = mj_name2id(m, mjOBJ_BODY, c.body.c_str());
+          if (id < 0 || !body.is_link(m, id)) {
+            fail(tr.line, "phases." + phase.name + ".next.body", "expected a body of " + who + ", got \"" + c.body + "\" (no such body)");
+          }
+        }
+      }
+    }
+  }
+  return b;
+}
+
+}  // namespace diverse
