@@ -277,6 +277,8 @@ SkillFile load_skill_file(const std::string& path) {
   if (root_kind == "free") s.root = RootKind::kFree;
   else if (root_kind != "planar") r.fail("root", "expected \"planar\" or \"free\", got \"" + root_kind + "\"");
   if (r.has("pairs")) s.pairs = r.strings("pairs");
+  if (r.has("root")) s.root_line = line_of(*root.get("root"));
+  if (r.has("pairs")) s.pairs_line = line_of(*root.get("pairs"));
 
   if (const toml::table* t = r.table("targets", true)) {
     const TomlReader tr = r.sub("targets", *t);
@@ -500,14 +502,14 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
   };
   const std::string who = "the character " + body.spec->file;
   if (body.root != skill.root) {
-    fail(1, "root", std::string("expected a character with a ") + to_string(skill.root) + " root, but " + who + " has a " +
+    fail(skill.root_line, "root", std::string("expected a character with a ") + to_string(skill.root) + " root, but " + who + " has a " +
                         to_string(body.root) + " root");
   }
   for (const std::string& role : skill.pairs) {
     const auto groups = select_groups(role, body);
-    if (groups.empty()) fail(1, "pairs", "expected a joint group with role \"" + role + "\", but " + who + " has none");
+    if (groups.empty()) fail(skill.pairs_line, "pairs", "expected a joint group with role \"" + role + "\", but " + who + " has none");
     if (body.groups[static_cast<size_t>(groups[0])].joints.size() != 2) {
-      fail(1, "pairs", "expected a left/right pair in the \"" + role + "\" group (two legs), in " + who);
+      fail(skill.pairs_line, "pairs", "expected a left/right pair in the \"" + role + "\" group (two legs), in " + who);
     }
   }
 

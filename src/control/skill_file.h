@@ -122,6 +122,7 @@ struct SkillFile {
   std::string name, description;
   RootKind root = RootKind::kPlanar;
   std::vector<std::string> pairs;  // roles that must be left/right pairs
+  int root_line = 1, pairs_line = 1;  // where they are written (1 when defaulted)
   std::string push, takeoff, peak, landing;  // phase names; "" when none
   std::vector<std::string> film_strip;       // events shown
   std::map<std::string, std::vector<SkillTarget>> target_sets;
