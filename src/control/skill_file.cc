@@ -237,6 +237,18 @@ SkillDuration read_duration(const TomlReader& r, const toml::table& phase) {
   return d;
 }
 
+// A module setting's number: in range for its name. Gains, forces, times and the lean are
+// not negative; stand_after is -1 (never) or more; offsets and gains on a velocity take any
+// finite value.
+void check_setting(const TomlReader& r, const std::string& key, double v) {
+  double lo = 0, hi = 1e9;
+  if (key == "offset" || key == "velocity_gain") lo = -1e9;
+  if (key == "stand_after") lo = -1;
+  if (key == "at_touchdown") hi = 1;
+  if (key == "turn") hi = 8 * M_PI;
+  if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + num(lo) + ", " + num(hi) + "], got " + num(v));
+}
+
 }  // namespace
 
 const std::vector<SkillModuleKind>& skill_module_kinds() {
@@ -325,6 +337,7 @@ SkillFile load_skill_file(const std::string& path) {
       SkillValue v = read_value(mr, key, node);
       if (v.kind == SkillValue::Kind::kCurve) mr.fail(key, "expected a number or a parameter (a setting takes no curve)");
       if (v.kind == SkillValue::Kind::kParam && !v.has_range) mr.fail(key, "expected a range = [LOWER, UPPER] for a module parameter");
+      if (v.kind == SkillValue::Kind::kNumber) check_setting(mr, key, v.number);
       m.settings[key] = v;
     }
     for (const char* key : kind->required) {
@@ -436,6 +449,7 @@ void override_skill_settings(SkillFile& skill, const TomlReader& r, const std::v
       }
       double v = 0;
       if (!as_number(sn, &v)) mr.fail(setting, "expected a number");
+      check_setting(mr, setting, v);
       SkillValue value;
       value.number = v;
       value.line = line_of(sn);

@@ -61,6 +61,7 @@ std::string task_text(const std::string& task, const std::vector<std::pair<std::
                       const std::string& append = "") {
   std::string t = read(kSource + "/tasks/" + task + ".toml");
   t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + kSource + "/assets/");
+  t = std::regex_replace(t, std::regex("\"\\.\\./skills/"), "\"" + kSource + "/skills/");
   t = std::regex_replace(t, std::regex("m0 = \""), "m0 = \"" + kSource + "/tasks/");
   t = std::regex_replace(t, std::regex("base = \""), "base = \"" + kSource + "/tasks/");
   for (const auto& [from, to] : replace) {
@@ -218,7 +219,9 @@ TEST(BadInput, TaskFileFields) {
                 "colour: expected no such key (unknown key; known keys: name, description, "),
       task_case(task_text("jump_high", {{"above_standing = 0.293", "above_standing = nan"}}),
                 "constraints.peak_height.above_standing: expected a number in [0, 5], got nan"),
-      task_case(task_text("jump_high", {{"type = \"jump2d\"", "type = \"jump9d\""}}), "controller.type"),
+      task_case(task_text("jump_high", {{"skill = \"", "type = \"jump9d\"\nskill = \""}}), "controller.type"),
+      task_case(task_text("jump_high", {{"skill = \"", "balance = { kp = -1.0 }\nskill = \""}}),
+                "controller.balance.kp: expected"),
       // jump3d's asymmetric option takes true or false only.
       task_case(task_text("jump_backwards", {{"asymmetric = true", "asymmetric = \"yes\""}}),
                 "controller.asymmetric: expected true or false"),

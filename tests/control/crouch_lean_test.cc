@@ -14,7 +14,7 @@
 #include <string>
 
 #include "support/task_errors.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -80,7 +80,7 @@ TEST(CrouchLean, APushedCrouchComesBackOntoItsPath) {
   std::printf("with crouch_lean = 0.2:\n");
   const Pushed lean = push_the_crouch(source + "/tasks/jump_forward.toml", source + "/tasks/jump_forward.m0.json");
   const std::string without =
-      test_files::task_variant("jump_forward", "crouch_lean_off", {"crouch_lean ="}, {}).string();
+      test_files::jump2d_variant("jump_forward", "crouch_lean_off", {"crouch_lean ="}, {}).string();
   std::printf("without it (the input motion found without it):\n");
   const Pushed held_over_feet =
       push_the_crouch(without, source + "/tests/control/data/jump_forward.no_lean.m0.json");
@@ -92,7 +92,7 @@ TEST(CrouchLean, APushedCrouchComesBackOntoItsPath) {
 TEST(CrouchLean, BadValuesAreRefused) {
   auto refused = [](const std::string& name, const std::string& line, const std::string& expected) {
     test_files::expect_task_refused(
-        test_files::task_variant("jump_forward", name, {"crouch_lean ="}, {{"controller", line}}).string(), expected);
+        test_files::jump2d_variant("jump_forward", name, {"crouch_lean ="}, {{"controller", line}}).string(), expected);
   };
   refused("lean_far", "crouch_lean = 2", "controller.crouch_lean: expected a number in");
   refused("lean_text", "crouch_lean = \"far\"", "controller.crouch_lean: expected a number");

@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "support/task_errors.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
 #include "task/task.h"
@@ -24,7 +24,7 @@ const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
 // backflip.toml with its open_turn line replaced by `lines`.
 std::string variant(const std::string& name, const std::string& lines) {
-  return test_files::task_variant("backflip", "flip_opening_" + name, {"open_turn ="}, {{"controller", lines}})
+  return test_files::jump2d_variant("backflip", "flip_opening_" + name, {"open_turn ="}, {{"controller", lines}})
       .string();
 }
 

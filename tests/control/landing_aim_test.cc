@@ -16,13 +16,14 @@
 #include <string>
 
 #include "control/jump_controller.h"
+#include "control/skill_controller.h"
 #include "core/error.h"
 #include "support/task_errors.h"
 #include "physics/rollout.h"
 #include "robust/robustness.h"
 #include "task/evaluate.h"
 #include "task/task.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 
 namespace diverse {
 namespace {
@@ -33,7 +34,7 @@ const std::string kSource = DIVERSE_SOURCE_DIR;
 // jump_high.toml with its landing_at_touchdown and landing_reach lines replaced by
 // `controller` (top of [controller]).
 fs::path variant(const std::string& name, const std::string& controller) {
-  return test_files::task_variant("jump_high", "landing_aim_" + name, {"landing_at_touchdown =", "landing_reach ="},
+  return test_files::jump2d_variant("jump_high", "landing_aim_" + name, {"landing_at_touchdown =", "landing_reach ="},
                                   {{"controller", controller}});
 }
 
@@ -55,12 +56,16 @@ double com_over_soles_at_touchdown(const TaskEvaluator& ev, const StepRecorder& 
 }
 
 TEST(LandingAim, TheHighJumpAsksForIt) {
+  // Its skill's landing module (skills/jump_high.toml).
   const Task task = load_task(kSource + "/tasks/jump_high.toml");
-  const auto* config = dynamic_cast<const JumpControllerConfig*>(task.controller_config.get());
+  const auto* config = dynamic_cast<const SkillConfig*>(task.controller_config.get());
   ASSERT_NE(config, nullptr);
-  EXPECT_TRUE(config->landing_control);
-  EXPECT_TRUE(config->landing_at_touchdown);
-  EXPECT_DOUBLE_EQ(config->landing_reach, 0.05);
+  const int landing = config->skill->module_index("landing");
+  ASSERT_GE(landing, 0);
+  const SkillModuleSpec& module = config->skill->modules[static_cast<size_t>(landing)];
+  EXPECT_EQ(module.kind, "foot_placement");
+  EXPECT_EQ(module.settings.at("at_touchdown").number, 1.0);
+  EXPECT_DOUBLE_EQ(module.settings.at("reach").number, 0.05);
   // Off unless asked for: the paper's aim.
   const Task paper = load_task(variant("paper", "").string());
   const auto* p = dynamic_cast<const JumpControllerConfig*>(paper.controller_config.get());

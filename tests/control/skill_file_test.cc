@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "control/skill_controller.h"
 #include "core/error.h"
 #include "support/text_files.h"
 #include "task/evaluate.h"
@@ -118,6 +119,45 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
     const int line = c.marker.empty() ? 1 : line_of(file, c.marker);
     EXPECT_EQ(message(file, c.bind ? &human : nullptr), file + ": line " + std::to_string(line) + ": " + c.expected)
         << c.name;
+  }
+}
+
+// A task's [controller] table naming a skill: the file must exist, and the other keys name
+// the skill's modules, whose number settings they override.
+TEST(SkillFile, TaskControllerTablesNameAnExistingSkillAndItsModules) {
+  const std::string skill = test_files::read_text(kRoot + "/skills/jump2d.toml");
+  auto refused = [&](const std::string& extra, const std::string& expected) {
+    try {
+      tiny_biped::task("controller_table", skill, extra);
+      ADD_FAILURE() << "accepted " << extra;
+    } catch (const UserError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(expected), std::string::npos) << m;
+    }
+  };
+  refused("bounce = 2", "controller.bounce: expected no such key (unknown key; known keys: type, skill, landing_height, "
+                        "balance, landing, the last the skill's modules as tables)");
+  refused("balance = { lean = \"far\" }", "controller.balance.lean: expected a number");
+  refused("balance = { colour = 1 }", "controller.balance.colour: expected a setting of the \"balance\" module balance");
+  refused("landing = { offset = 0.1 }",
+          "controller.landing.offset: expected a number setting (the skill makes landing.offset the parameter "
+          "\"landing.offset\")");
+  const Task ok = tiny_biped::task("controller_table", skill, "balance = { kp = 4000.0 }");
+  const auto& modules = dynamic_cast<const SkillConfig&>(*ok.controller_config).skill->modules;
+  EXPECT_EQ(modules[0].settings.at("kp").number, 4000.0);
+  EXPECT_EQ(modules[0].settings.at("kd").number, 300.0);
+  try {
+    const std::string task_file = (tiny_biped::dir() / "missing_skill.toml").string();
+    test_files::write_text(task_file, "name = \"m\"\ncharacter = \"tiny_biped.toml\"\nmetric = \"md\"\nvariations = 1\n"
+                                      "m0 = \"none.json\"\n[controller]\nskill = \"nowhere.toml\"\n[constraints]\n"
+                                      "weight = 1.0\nfall_penalty = 1.0\n");
+    load_task(task_file);
+    ADD_FAILURE() << "a missing skill file was accepted";
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), (tiny_biped::dir() / "missing_skill.toml").string() +
+                                         ": controller.skill: expected an existing skill file (relative to the task "
+                                         "file), but " +
+                                         (tiny_biped::dir() / "nowhere.toml").string() + " does not exist");
   }
 }
 

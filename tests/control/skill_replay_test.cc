@@ -1,13 +1,15 @@
-// The 2D jumps as skill files (skills/): each committed input motion gives the same rollout
-// under the skill engine (control/skill_controller.h) as under the "jump2d" controller it
-// replaces, the same qpos at every step to the last bit, at the task's timestep and at half
-// of it, and the same parameter names in the same order.
+// The 2D jumps as skill files (skills/): each committed task, which names its skill, gives
+// its input motion the same rollout under the skill engine (control/skill_controller.h) as
+// under the "jump2d" controller with the keys the task gave it before
+// (support/jump2d_variant.h): the same qpos at every step to the last bit, at the task's
+// timestep and at half of it, the same phase times, and the same parameter names in the
+// same order.
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "physics/rollout.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -16,32 +18,15 @@ namespace {
 
 struct Case {
   const char* task;
-  const char* skill;  // the [controller] table of the task under the engine
 };
-
-// The jump2d task file's [controller] table replaced by `controller`.
-Task under(const Case& c, const std::string& controller) {
-  const std::string source = DIVERSE_SOURCE_DIR;
-  const auto file = test_files::task_variant(
-      c.task, std::string("skill_replay_") + c.task + (controller.empty() ? "_jump2d" : "_skill"),
-      controller.empty() ? std::vector<std::string>{}
-                         : std::vector<std::string>{"type =", "landing_control =", "landing_height =", "tuck_time =",
-                                                    "open_time =", "open_turn =", "balance_kp =", "balance_kd =",
-                                                    "balance_max_force =", "stance_landing =", "stand_after =",
-                                                    "landing_at_touchdown =", "landing_reach =", "crouch_lean =",
-                                                    "level_feet ="},
-      {{"controller", controller}});
-  return load_task(file.string());
-}
-
 class SkillReplay : public ::testing::TestWithParam<Case> {};
 
 TEST_P(SkillReplay, SameQposAtEveryStepAsJump2d) {
   const Case c = GetParam();
-  const std::string skills = std::string(DIVERSE_SOURCE_DIR) + "/skills/";
-  const Task old_task = under(c, "");
+  const Task old_task = load_task(test_files::jump2d_variant(c.task, std::string("replay_") + c.task, {}, {}).string());
   ASSERT_EQ(old_task.controller, "jump2d");
-  const Task new_task = under(c, "skill = \"" + skills + c.skill);
+  const Task new_task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + c.task + ".toml");
+  ASSERT_EQ(new_task.controller, "skill");
   const TaskEvaluator old_eval(old_task), new_eval(new_task);
   // The same parameters, by name and in order.
   const ParameterSet old_params = old_eval.parameters(), new_params = new_eval.parameters();
@@ -80,13 +65,8 @@ TEST_P(SkillReplay, SameQposAtEveryStepAsJump2d) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Jumps, SkillReplay,
-                         ::testing::Values(Case{"backflip", "backflip.toml\""},
-                                           Case{"jump_forward", "jump_forward.toml\""},
-                                           Case{"jump_over", "jump_forward.toml\""},
-                                           Case{"jump_high", "jump_high.toml\""},
-                                           Case{"jump_onto",
-                                                "jump2d.toml\"\nlanding_height = 0.5\n"
-                                                "balance = { kp = 4000.0, kd = 800.0, max_force = 800.0 }"}),
+                         ::testing::Values(Case{"backflip"}, Case{"jump_forward"}, Case{"jump_over"},
+                                           Case{"jump_high"}, Case{"jump_onto"}),
                          [](const ::testing::TestParamInfo<Case>& param) { return std::string(param.param.task); });
 
 }  // namespace

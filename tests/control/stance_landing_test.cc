@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "support/task_errors.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -22,7 +22,7 @@ namespace {
 // jump_forward.toml with `lines` at the top of its [controller] table in place of the
 // committed file's own landing keys.
 std::string variant(const std::string& name, const std::string& lines) {
-  return test_files::task_variant("jump_forward", "stance_landing_" + name,
+  return test_files::jump2d_variant("jump_forward", "stance_landing_" + name,
                                   {"stance_landing =", "stand_after =", "stand_duration =", "balance_kp =",
                                    "balance_kd =", "balance_max_force =", "crouch_lean ="},
                                   {{"controller", lines}})

@@ -14,11 +14,12 @@
 #include <string>
 
 #include "control/jump_controller.h"
+#include "control/skill_controller.h"
 #include "core/error.h"
 #include "physics/rollout.h"
 #include "task/evaluate.h"
 #include "task/task.h"
-#include "support/task_variant.h"
+#include "support/jump2d_variant.h"
 
 namespace diverse {
 namespace {
@@ -31,7 +32,7 @@ const std::string kHops = kSource + "/tests/task/data/jump_high_paper_feet.m0.js
 // (top of [controller]) and `simulation` (top of [simulation]); the landing aim and the
 // balance servo are the paper's, as the earlier input motion was found with them.
 fs::path variant(const std::string& name, const std::string& controller, const std::string& simulation) {
-  return test_files::task_variant("jump_high", "standing_start_" + name,
+  return test_files::jump2d_variant("jump_high", "standing_start_" + name,
                                   // The earlier motions were found under MuJoCo's damping at 2 ms.
                                   {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach =",
                                    "balance_kp =", "balance_kd =", "balance_max_force =", "damping =", "timestep ="},
@@ -114,9 +115,10 @@ TEST(StandingStart, AHopBeforeTheJumpIsAFall) {
 Footing crouch_of(const std::string& task_file) {
   const Task task = load_task(task_file);
   EXPECT_TRUE(task.simulation.hop_is_fall);
+  // Level feet: jump2d's key, or a skill whose first phase aims the soles level.
   const auto* config = dynamic_cast<const JumpControllerConfig*>(task.controller_config.get());
-  EXPECT_NE(config, nullptr);
-  EXPECT_TRUE(config != nullptr && config->level_feet);
+  const auto* skill = dynamic_cast<const SkillConfig*>(task.controller_config.get());
+  EXPECT_TRUE((config != nullptr && config->level_feet) || (skill != nullptr && skill->skill->phases[0].targets == "level"));
   const TaskEvaluator ev(task);
   StepRecorder rec;
   auto w = ev.make_worker();
