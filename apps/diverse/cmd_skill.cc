@@ -1,4 +1,4 @@
-// `diverse skill check FILE [--character C]`: reads a skill file (docs/skills.md) and binds
+// `diverse skill check FILE [--character C]`: reads a skill file (docs/reference/skills.md) and binds
 // it to a character, as a task naming it would; any problem is one line naming the file, the
 // line, the field and what was expected (exit code 2).
 // `diverse skill show FILE [--character C]`: prints its phases with their targets, gains,
@@ -128,7 +128,7 @@ void install_skill(CLI::App& app) {
   CLI::App* check = cmd->add_subcommand("check", "Read a skill file and bind it to a character; report any problem");
   CLI::App* show_cmd = cmd->add_subcommand("show", "Print a skill's phases, transitions, modules and parameters");
   for (CLI::App* sub : {check, show_cmd}) {
-    sub->add_option("file", args->file, "Skill file (.toml, docs/skills.md)")->required();
+    sub->add_option("file", args->file, "Skill file (.toml, docs/reference/skills.md)")->required();
     sub->add_option("--character", args->character,
                     "Character file (default: the planar or the 3D human, by the skill's root)");
   }

@@ -1,5 +1,5 @@
 // The skill engine: one controller that runs any skill file (control/skill_file.h,
-// docs/skills.md), registered as the controller type "skill". A task names its skill:
+// docs/reference/skills.md), registered as the controller type "skill". A task names its skill:
 //
 //   [controller]
 //   skill = "../skills/jump2d.toml"   # relative to the task file

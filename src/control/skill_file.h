@@ -1,5 +1,5 @@
 // Skill files (skills/NAME.toml): a skill as data, run by the skill engine
-// (control/skill_controller.h). docs/skills.md describes every field.
+// (control/skill_controller.h). docs/reference/skills.md describes every field.
 //
 //   SkillFile skill = load_skill_file("skills/jump2d.toml");   // the file alone
 //   SkillBinding b = bind_skill(skill, body, model);          // against one character

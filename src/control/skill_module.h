@@ -1,5 +1,5 @@
 // Feedback modules of the skill engine (control/skill_controller.h): small components a
-// skill file's phase switches on by name ([[modules]] in docs/skills.md). Each kind lives
+// skill file's phase switches on by name ([[modules]] in docs/reference/skills.md). Each kind lives
 // in its own control/module_KIND.{h,cc} with the paper it comes from.
 //
 // The engine calls, in one control step: update() for the modules of the current phase

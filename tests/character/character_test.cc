@@ -251,6 +251,7 @@ TEST(CharacterErrors, TheCommandLineSaysSoAndExitsWithTwo) {
   const fs::path task = fs::path(c.file()).parent_path() / "task.toml";
   std::string text = read_text(std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.toml");
   text = edit(text, "character = \"../assets/characters/human2d.toml\"", "character = \"human2d.toml\"");
+  text = edit(text, "skill = \"../skills/", "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/");
   text = edit(text, "m0 = \"jump_high.m0.json\"", "m0 = \"" + std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high.m0.json\"");
   text = edit(text, "base = \"jump_high_start.json\"", "base = \"" + std::string(DIVERSE_SOURCE_DIR) + "/tasks/jump_high_start.json\"");
   write_text(task.string(), text);

@@ -715,6 +715,7 @@ TEST(ShapeBiped, VaryShapeOnACharacterWithoutShapeParametersIsOneLineWithExitCod
   };
   const std::string tasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
   edit("character = \"../assets/characters/human2d.toml\"", "character = \"human2d.toml\"");
+  edit("skill = \"../skills/", "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/");
   edit("m0 = \"jump_high.m0.json\"", "m0 = \"" + tasks + "jump_high.m0.json\"");
   edit("base = \"jump_high_start.json\"", "base = \"" + tasks + "jump_high_start.json\"");
   write_text((dir / "task.toml").string(), task);

@@ -6,10 +6,14 @@
 // same order.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <string>
 
 #include "physics/rollout.h"
 #include "support/jump2d_variant.h"
+#include "support/text_files.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -21,12 +25,9 @@ struct Case {
 };
 class SkillReplay : public ::testing::TestWithParam<Case> {};
 
-TEST_P(SkillReplay, SameQposAtEveryStepAsJump2d) {
-  const Case c = GetParam();
-  const Task old_task = load_task(test_files::jump2d_variant(c.task, std::string("replay_") + c.task, {}, {}).string());
-  ASSERT_EQ(old_task.controller, "jump2d");
-  const Task new_task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + c.task + ".toml");
-  ASSERT_EQ(new_task.controller, "skill");
+// The two tasks give the input motion of the first the same parameters and the same
+// rollout, step by step, at the task's timestep and at half of it.
+void expect_same_rollouts(const Task& old_task, const Task& new_task) {
   const TaskEvaluator old_eval(old_task), new_eval(new_task);
   // The same parameters, by name and in order.
   const ParameterSet old_params = old_eval.parameters(), new_params = new_eval.parameters();
@@ -62,6 +63,33 @@ TEST_P(SkillReplay, SameQposAtEveryStepAsJump2d) {
     for (size_t p = 0; p < a.phases.begin.size(); ++p) EXPECT_EQ(a.phases.begin[p], b.phases.begin[p]) << p;
     EXPECT_EQ(a.phases.names, b.phases.names);
   }
+}
+
+TEST_P(SkillReplay, SameQposAtEveryStepAsJump2d) {
+  const Case c = GetParam();
+  const Task old_task = load_task(test_files::jump2d_variant(c.task, std::string("replay_") + c.task, {}, {}).string());
+  ASSERT_EQ(old_task.controller, "jump2d");
+  const Task new_task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + c.task + ".toml");
+  ASSERT_EQ(new_task.controller, "skill");
+  expect_same_rollouts(old_task, new_task);
+}
+
+// Another character: the tailwalker's leap (examples/own-character/), which names "jump2d"
+// with the paper's keys, under skills/jump2d.toml.
+TEST(SkillReplay, TheTailwalkersLeapUnderThePapersJump) {
+  const std::string dir = std::string(DIVERSE_SOURCE_DIR) + "/examples/own-character/";
+  std::string text = test_files::read_text(dir + "leap.toml");
+  const auto from = text.find("[controller]\n"), to = text.find("\n[", from + 1);
+  text.replace(from, to - from, "[controller]\nskill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/jump2d.toml\"\n");
+  for (const char* key : {"character = \"", "m0 = \"", "base = \""}) {
+    const auto at = text.find(key);
+    text.insert(at + std::string(key).size(), dir);
+  }
+  const auto file = std::filesystem::temp_directory_path() / ("diverse_leap_skill_" + std::to_string(::getpid()) + ".toml");
+  test_files::write_text(file.string(), text);
+  const Task old_task = load_task(dir + "leap.toml");
+  ASSERT_EQ(old_task.controller, "jump2d");
+  expect_same_rollouts(old_task, load_task(file.string()));
 }
 
 INSTANTIATE_TEST_SUITE_P(Jumps, SkillReplay,

@@ -166,6 +166,7 @@ std::string unchecked_task() {
   };
   swap("half_timestep = true", "half_timestep = false");
   swap("\"../assets/", "\"" + kSource + "/assets/");
+  swap("\"../skills/", "\"" + kSource + "/skills/");
   swap("\"jump_high.m0.json\"", "\"" + kSource + "/tasks/jump_high.m0.json\"");
   swap("\"jump_high_start.json\"", "\"" + kSource + "/tasks/jump_high_start.json\"");
   const fs::path dir = test_files::scratch_dir("strength_bounds_task");

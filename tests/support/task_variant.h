@@ -33,6 +33,7 @@ inline std::filesystem::path task_variant(const std::string& task, const std::st
     text.replace(at, from.size(), to);
   };
   replace("character = \"../", "character = \"" + source + "/");
+  if (text.find("skill = \"../") != std::string::npos) replace("skill = \"../", "skill = \"" + source + "/");
   replace("m0 = \"", "m0 = \"" + source + "/tasks/");
   if (text.find("\nbase = \"") != std::string::npos) replace("\nbase = \"", "\nbase = \"" + source + "/tasks/");
   for (const auto& [section, lines] : add_to_sections) {

@@ -123,6 +123,7 @@ fs::path copy_task(const fs::path& dir, const std::string& name, const std::stri
   const std::string source = DIVERSE_SOURCE_DIR;
   std::string t = read_file(source + "/tasks/" + name + ".toml");
   t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + source + "/assets/");
+  t = std::regex_replace(t, std::regex("\"\\.\\./skills/"), "\"" + source + "/skills/");
   t = std::regex_replace(t, std::regex("\nm0 = \"[^\"]*\""), "\nm0 = \"" + (dir / (name + ".m0.json")).string() + "\"");
   t = std::regex_replace(t, std::regex("\nbase = \""), "\nbase = \"" + source + "/tasks/");
   t = std::regex_replace(t, std::regex("\n\\[seed\\]\n"), "\n[seed]\n" + seed_extra);
@@ -178,6 +179,9 @@ TEST(SeedMotionCli, ACandidateThatFailsTheSuitesPartIsNeverWrittenAsTheM0) {
   const fs::path task = copy_task(dir, "jump_high", "popsize = 6\n");
   {
     std::string t = read_file(task.string());
+    // The paper's jump (skills/jump2d.toml): its foot targets, its landing aim, its balance
+    // servo.
+    t = std::regex_replace(t, std::regex("skills/jump_high\\.toml"), "skills/jump2d.toml");
     t = std::regex_replace(t, std::regex("\nlevel_feet = true"), "\nlevel_feet = false");
     t = std::regex_replace(t, std::regex("\nhop_is_fall = true"), "\nhop_is_fall = false");
     t = std::regex_replace(t, std::regex("\nlanding_at_touchdown = true"), "\nlanding_at_touchdown = false");
