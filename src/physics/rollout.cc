@@ -209,6 +209,12 @@ RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps, Joi
   return rollout(worker, hooks, max_steps, drive.dofs(), &drive, recorder);
 }
 
+bool replay_each_step(mjModel* m, mjData* d, const StepRecorder& record, int steps,
+                      const std::function<bool(int, const mjData*)>& after_step) {
+  install_mujoco_handlers();
+  return replay_steps(m, d, record, steps, after_step);
+}
+
 double replay(mjModel* m, const StepRecorder& record) {
   install_mujoco_handlers();
   mjData* d = mj_makeData(m);

@@ -18,6 +18,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -85,5 +86,14 @@ RolloutStats run_rollout(SimWorker& worker, StepHooks& hooks, int max_steps, Joi
 // largest |qpos difference| from the recorded qpos over all steps. `m` is modified
 // (dof_damping), so pass a private copy.
 double replay(mjModel* m, const StepRecorder& record);
+
+// Replays the record's first `steps` steps on `m` (its dof_damping is modified) with plain
+// mj_step from d's reset state, calling after_step(step, d) after each mj_step: d then holds
+// the contacts, constraint forces and kinematics of the state before the step and the
+// velocity after it (the Euler step moved the positions with that velocity). Stops early
+// when after_step returns false. Returns false if MuJoCo raised an error. For measures of
+// a motion taken from its exact replay (task/foot_slip.h).
+bool replay_each_step(mjModel* m, mjData* d, const StepRecorder& record, int steps,
+                      const std::function<bool(int, const mjData*)>& after_step);
 
 }  // namespace diverse
