@@ -13,8 +13,16 @@
 // run's (RUN/run.json beside motions/), else tasks/<task>.toml. A --task for another
 // controller or character than the motion's is refused before anything is replayed: one
 // line naming the motion file, the field (parameters, replay.model) and what was expected.
+//
+// Every motion's feet are measured from the same plain-MuJoCo replay (task/foot_slip.h):
+// per side, the stances and how far the loaded feet slid in them. `diverse foot-slip
+// PATH...` measures that alone, for motion files and for every motion of run directories,
+// as a Markdown table or (--json) JSON: a run written before the measure, or a motion of
+// `simulate`, has it without being run again. It is a command of its own rather than an
+// option of replay because it takes many motions and whole runs, and never fails a motion.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -53,8 +61,8 @@ NetTorqueCheck check_motion_torques(const std::string& path, std::string* worst_
   return check;
 }
 
-// The task file of a walk motion: `given`, else the run's, else tasks/<name>.toml.
-std::string walk_task_file(const std::string& motion_path, const nlohmann::json& motion, const std::string& given) {
+// The task file of a motion: `given`, else the run's, else tasks/<name>.toml.
+std::string motion_task_file(const std::string& motion_path, const nlohmann::json& motion, const std::string& given) {
   if (!given.empty()) return given;
   const std::filesystem::path run_json = std::filesystem::path(motion_path).parent_path().parent_path() / "run.json";
   if (std::filesystem::exists(run_json)) {
@@ -68,8 +76,18 @@ std::string walk_task_file(const std::string& motion_path, const nlohmann::json&
   try {
     return resolve_task_path(name);
   } catch (const UserError&) {
-    throw UserError(motion_path + ": task: the walk's task file '" + name +
+    throw UserError(motion_path + ": task: the motion's task file '" + name +
                     "' was not found; give it with --task FILE");
+  }
+}
+
+// True when motion_task_file() finds a task file without --task.
+bool task_file_exists(const std::string& motion_path, const nlohmann::json& motion) {
+  try {
+    motion_task_file(motion_path, motion, "");
+    return true;
+  } catch (const UserError&) {
+    return false;
   }
 }
 
@@ -120,7 +138,7 @@ void check_task_of_motion(const std::string& path, const std::string& task_optio
 bool audit_walk_motion(const std::string& path, const std::string& task_option) {
   const nlohmann::json motion = read_json(path);
   if (!motion.contains("summary") || !motion["summary"].contains("walk_steps")) return true;
-  const Task task = load_task(walk_task_file(path, motion, task_option));
+  const Task task = load_task(motion_task_file(path, motion, task_option));
   if (!task.walk.enabled) throw UserError(task.file + ": expected a walk task (a [walk] table) for the walk " + path);
   std::filesystem::path model_path;
   const StepRecorder record = read_replay_record(motion, path, &model_path);
@@ -145,6 +163,78 @@ bool audit_walk_motion(const std::string& path, const std::string& task_option) 
   }
   for (const std::string& v : a.violations) std::fprintf(stderr, "diverse: walk audit: %s\n", v.c_str());
   return false;
+}
+
+// How far a motion's feet slid, measured by replaying it (task/foot_slip.h); the feet
+// are those of its task's character.
+FootSlip motion_foot_slip(const std::string& path, const std::string& task_option) {
+  const nlohmann::json motion = read_json(path);
+  const Task task = load_task(motion_task_file(path, motion, task_option));
+  return motion_file_foot_slip(path, task.character_spec);
+}
+
+void print_foot_slip(const FootSlip& slip) {
+  const char* names[2] = {"left ", "right"};
+  for (size_t s = 0; s < 2; ++s) {
+    const FootSlip::Side& side = slip.sides[s];
+    std::printf("foot slip, %s feet: %zu stances, %.4f m in all, per stance %.2f cm on average and %.2f cm at most, "
+                "up to %.3f m/s",
+                names[s], side.stances.size(), side.total, 100 * side.mean, 100 * side.largest, side.max_speed);
+    if (side.max_speed_time >= 0) std::printf(" (at %.3f s)", side.max_speed_time);
+    std::printf("\n");
+  }
+}
+
+// `diverse foot-slip PATH...`: motion files, and run directories (every motions/*.json).
+void install_foot_slip(CLI::App& app) {
+  auto paths = std::make_shared<std::vector<std::string>>();
+  auto task = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand(
+      "foot-slip", "How far planted feet slide in motions, measured by replaying them in plain MuJoCo");
+  cmd->add_option("paths", *paths, "Motion files (motion.json) and run directories")->required();
+  cmd->add_option("--task", *task, "Task file whose character's feet are measured (default: the run's, else tasks/<task>.toml)");
+  cmd->add_flag("--json", *json, "Print JSON (per motion: file, label and the measure) instead of a table");
+  cmd->callback([paths, task, json] {
+    std::vector<std::string> files;
+    for (const std::string& p : *paths) {
+      const std::filesystem::path motions = std::filesystem::path(p) / "motions";
+      if (!std::filesystem::is_directory(p)) {
+        if (!std::filesystem::exists(p)) throw UserError(p + ": no such motion file or run directory");
+        files.push_back(p);
+        continue;
+      }
+      if (!std::filesystem::is_directory(motions))
+        throw UserError(p + ": not a run directory (no motions/) and not a motion file");
+      std::vector<std::string> found;
+      for (const auto& entry : std::filesystem::directory_iterator(motions))
+        if (entry.path().extension() == ".json") found.push_back(entry.path().string());
+      // m0, m1, ..., m10 in numeric order.
+      std::sort(found.begin(), found.end(), [](const std::string& a, const std::string& b) {
+        return a.size() != b.size() ? a.size() < b.size() : a < b;
+      });
+      files.insert(files.end(), found.begin(), found.end());
+    }
+    nlohmann::json out = nlohmann::json::array();
+    if (!*json)
+      std::printf("| motion | label | side | stances | slide in all (m) | mean per stance (cm) | largest per stance (cm) | "
+                  "fastest (m/s) |\n|---|---|---|---|---|---|---|---|\n");
+    for (const std::string& file : files) {
+      const FootSlip slip = motion_foot_slip(file, *task);
+      const std::string label = read_json(file).value("label", std::string());
+      if (*json) {
+        out.push_back({{"file", file}, {"label", label}, {"foot_slip", foot_slip_json(slip)}});
+        continue;
+      }
+      for (size_t s = 0; s < 2; ++s) {
+        const FootSlip::Side& side = slip.sides[s];
+        std::printf("| %s | %s | %s | %zu | %.3f | %.2f | %.2f | %.2f |\n", file.c_str(), label.c_str(),
+                    s == 0 ? "left" : "right", side.stances.size(), side.total, 100 * side.mean, 100 * side.largest,
+                    side.max_speed);
+      }
+    }
+    if (*json) std::printf("%s\n", out.dump(2).c_str());
+  });
 }
 
 void install(CLI::App& app) {
@@ -185,12 +275,22 @@ void install(CLI::App& app) {
                    100 * kTorqueTolerance);
       failed = true;
     }
+    // The feet are the task's character's: a motion without a task file to find (made by
+    // another program) is replayed and checked without them.
+    const nlohmann::json motion = read_json(*path);
+    if (!task->empty() || task_file_exists(*path, motion)) {
+      print_foot_slip(motion_foot_slip(*path, *task));
+    } else {
+      std::printf("foot slip: not measured (no task file for task '%s'; give it with --task FILE)\n",
+                  motion.value("task", std::string()).c_str());
+    }
     if (!audit_walk_motion(*path, *task)) failed = true;
     if (failed) std::exit(1);
   });
 }
 
 const bool registered = register_command(51, install);
+const bool registered_foot_slip = register_command(53, install_foot_slip);
 
 }  // namespace
 }  // namespace diverse::cli

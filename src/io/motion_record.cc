@@ -227,26 +227,46 @@ StepRecorder read_replay_record(const nlohmann::json& motion, const fs::path& js
   return record;
 }
 
-double replay_motion_file(const fs::path& json_path, int* steps) {
+namespace {
+
+// A motion file's record and a private copy of its saved model, checked against each other.
+using ModelCopy = std::unique_ptr<mjModel, void (*)(mjModel*)>;
+ModelCopy load_replay(const fs::path& json_path, StepRecorder* record) {
   const nlohmann::json motion = read_json(json_path);
   fs::path model_path;
-  const StepRecorder record = read_replay_record(motion, json_path, &model_path);
+  *record = read_replay_record(motion, json_path, &model_path);
   const auto model = SharedModel::from_file(model_path.string());
   // The copy is freed on every path out, the errors included; they read the model before.
-  const std::unique_ptr<mjModel, void (*)(mjModel*)> copy(mj_copyModel(nullptr, model->get()), mj_deleteModel);
+  ModelCopy copy(mj_copyModel(nullptr, model->get()), mj_deleteModel);
   const mjModel* m = copy.get();
-  if (m->nq != record.nq || m->nu != record.nu || m->nv != static_cast<int>(record.qvel0.size()))
+  if (m->nq != record->nq || m->nu != record->nu || m->nv != static_cast<int>(record->qvel0.size()))
     throw UserError(json_path.string() + ": replay: nq/nu do not match the model " + model_path.string());
-  for (int dof : record.damped_dofs) {
+  for (int dof : record->damped_dofs) {
     if (dof >= m->nv)
       throw UserError(json_path.string() + ": replay.damped_dofs: expected dof indices below the model's nv (" +
                       std::to_string(m->nv) + "), got " + std::to_string(dof));
   }
-  if (std::fabs(m->opt.timestep - record.timestep) > 0)
+  if (std::fabs(m->opt.timestep - record->timestep) > 0)
     throw UserError(json_path.string() + ": replay.timestep: does not match the model's");
+  return copy;
+}
+
+}  // namespace
+
+double replay_motion_file(const fs::path& json_path, int* steps) {
+  StepRecorder record;
+  const ModelCopy copy = load_replay(json_path, &record);
   const double diff = replay(copy.get(), record);
   if (steps) *steps = record.steps();
   return diff;
+}
+
+FootSlip motion_file_foot_slip(const fs::path& json_path, std::shared_ptr<const CharacterSpec> spec,
+                               const FootSlipOptions& options) {
+  StepRecorder record;
+  const ModelCopy copy = load_replay(json_path, &record);
+  const Character body = bind_character(std::move(spec), copy.get(), json_path.string());
+  return measure_foot_slip(copy.get(), record, body, options);
 }
 
 }  // namespace diverse

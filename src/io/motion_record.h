@@ -45,6 +45,7 @@
 
 #include "physics/rollout.h"
 #include "task/evaluate.h"
+#include "task/foot_slip.h"
 
 namespace diverse {
 
@@ -84,5 +85,11 @@ StepRecorder read_replay_record(const nlohmann::json& motion, const std::filesys
 // largest |qpos difference| from the recorded qpos over all steps (infinity if the
 // replay blew up). Throws UserError if the file or its model cannot be read.
 double replay_motion_file(const std::filesystem::path& json_path, int* steps = nullptr);
+
+// Replays a motion file's inputs on its saved model, as replay_motion_file() does, and
+// measures how far its feet slide (task/foot_slip.h); the feet are those of the character
+// file `spec` bound to the saved model. Throws UserError as replay_motion_file().
+FootSlip motion_file_foot_slip(const std::filesystem::path& json_path, std::shared_ptr<const CharacterSpec> spec,
+                               const FootSlipOptions& options = {});
 
 }  // namespace diverse
