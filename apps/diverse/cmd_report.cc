@@ -2,7 +2,9 @@
 // summary.json files. Used by the reproduction scripts in scripts/. Runs whose
 // robustness was measured (RUN/robustness.json, `diverse robustness RUN`) add a second
 // table after it: per motion, the share of perturbed rollouts of each kind that meet
-// the task (robust/robustness.h).
+// the task (robust/robustness.h). Runs whose summary has each motion's foot slip
+// (task/foot_slip.h) add a table of it: per motion and side, the stances and how far the
+// planted feet slid per stance (mean and largest) and at most how fast.
 //
 //   diverse report runs/repro/*
 #include <CLI/CLI.hpp>
@@ -38,7 +40,7 @@ void install_report(CLI::App& app) {
     // The robustness of a run's motions (RUN/robustness.json, `diverse robustness RUN`) is
     // read now too, and tabled after the runs: per motion, the share of each kind of
     // perturbed rollouts that meet the task.
-    std::vector<std::string> robustness_rows;
+    std::vector<std::string> robustness_rows, slip_rows;
     for (const std::string& dir : *runs) {
       if (!std::filesystem::exists(std::filesystem::path(dir) / "summary.json"))
         throw UserError(dir + ": not a finished run (no summary.json)");
@@ -81,6 +83,19 @@ void install_report(CLI::App& app) {
             }
           }
         if (pairs > 0) mean_var /= pairs;
+        for (const auto& m : s.at("motions")) {
+          if (!m.contains("foot_slip")) continue;
+          const nlohmann::json& f = m.at("foot_slip");
+          std::string row = "| " + std::filesystem::path(dir).filename().string() + " | " +
+                            m.at("label").get<std::string>() + " |";
+          for (const char* side : {"left", "right"}) {
+            const nlohmann::json& fs = f.at(side);
+            row += " " + std::to_string(fs.at("stances").get<int>()) + " | " +
+                   format("%.2f", 100 * fs.at("mean_per_stance").get<double>()) + " | " +
+                   format("%.2f", 100 * fs.at("largest_per_stance").get<double>()) + " |";
+          }
+          slip_rows.push_back(row + " " + format("%.2f", f.at("max_speed").get<double>()) + " |");
+        }
         std::string constraints;
         for (const auto& m : s.at("motions"))
           if (m.at("index").get<int>() > 0)
@@ -103,6 +118,11 @@ void install_report(CLI::App& app) {
     if (!robustness_rows.empty()) {
       std::printf("\n| run | motion | robustness (perturbed rollouts that meet the task) |\n|---|---|---|\n");
       for (const std::string& row : robustness_rows) std::printf("%s\n", row.c_str());
+    }
+    if (!slip_rows.empty()) {
+      std::printf("\n| run | motion | left stances | left cm per stance | left largest cm | right stances | "
+                  "right cm per stance | right largest cm | fastest slide m/s |\n|---|---|---|---|---|---|---|---|---|\n");
+      for (const std::string& row : slip_rows) std::printf("%s\n", row.c_str());
     }
   });
 }

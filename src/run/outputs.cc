@@ -121,6 +121,14 @@ void write_run_outputs(const RunOutputs& o) {
                                   &records[i]);
   });
 
+  // How far each motion's planted feet slide (task/foot_slip.h), from a plain-MuJoCo
+  // replay of the record just written on the model just saved.
+  std::vector<nlohmann::json> foot_slips(count);
+  o.pool.parallel_for(count, [&](std::size_t i, int) {
+    foot_slips[i] = foot_slip_json(motion_file_foot_slip(o.dir / "motions" / (stem(i) + ".json"),
+                                                         o.evaluator.task().character_spec));
+  });
+
   // A character without shape parameters has no scales and no link lengths.
   const ShapeSpace* shapes = o.evaluator.has_shape() ? &o.evaluator.shapes() : nullptr;
   // Effort and distance from M0 of every motion, and whether it keeps the run's bounds.
@@ -155,6 +163,7 @@ void write_run_outputs(const RunOutputs& o) {
                        {"landing_x", outcome.landing_x},
                        {"peak_com_z", outcome.peak_com_z},
                        {"half_timestep", half_timestep_json(evaluations[i])},
+                       {"foot_slip", foot_slips[i]},
                        {"shape_scales", scales},
                        {"link_lengths", std::vector<double>(lengths.data(), lengths.data() + lengths.size())},
                        {"file", "motions/" + stem(i) + ".json"}});

@@ -38,7 +38,8 @@ struct RunOutputs {
 // robust/robustness.h), per motion its C (the
 // task's constraints and the bounds'; "task_constraint" the task's alone), dmin, effort
 // (N^2 m^2 s), "effort_ratio" to M0's, "positive_work" (J), "distance_to_m0" in the
-// objective's distance, "within_bounds", shape scales and link lengths (m,
+// objective's distance, "within_bounds", "foot_slip" (how far its planted feet slide, per
+// side, measured by replaying its motion file: task/foot_slip.h), shape scales and link lengths (m,
 // "link_names" order; none for a character without shape parameters), and "distances": the pairwise matrices over M0..MN of every motion
 // metric (hf, md, wja) and of the shape metric (all zero when the shape did not vary),
 // plus the objective's own matrix when it combines a motion metric with the shape.

@@ -108,6 +108,24 @@ TEST(Run, SameSeedGivesIdenticalSummaryWithOneAndTwoThreads) {
     EXPECT_EQ(m["kinds"]["half_timestep"]["count"], 1);
   }
   EXPECT_EQ(read_json(one / "robustness.json")["motions"].size(), 3u);
+
+  // Every motion's foot slip (task/foot_slip.h), as `diverse foot-slip` measures it from
+  // the motion files, and in the report's table.
+  const Result slip = run_cli("foot-slip --json " + one.string());
+  ASSERT_EQ(slip.status, 0) << slip.output;
+  const nlohmann::json measured = nlohmann::json::parse(slip.output);
+  ASSERT_EQ(measured.size(), 3u);
+  for (int i = 0; i <= 2; ++i) {
+    const auto& f = sa["motions"][i]["foot_slip"];
+    EXPECT_EQ(f, measured[i]["foot_slip"]) << i;
+    EXPECT_EQ(measured[i]["label"], "M" + std::to_string(i));
+    EXPECT_EQ(f["left"]["stances"], 2) << i;  // standing, then landed
+    EXPECT_GE(f["largest_per_stance"].get<double>(), f["left"]["mean_per_stance"].get<double>()) << i;
+  }
+  const Result report = run_cli("report " + one.string());
+  ASSERT_EQ(report.status, 0) << report.output;
+  EXPECT_NE(report.output.find("| left stances | left cm per stance |"), std::string::npos) << report.output;
+  EXPECT_NE(report.output.find("| M2 | 2 | "), std::string::npos) << report.output;
 }
 
 // summary.json's timing.rollouts: every rollout of the run (M0 once, then N x lambda per
