@@ -23,8 +23,10 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include "command.h"
@@ -134,8 +136,17 @@ void check_task_of_motion(const std::string& path, const std::string& task_optio
                           " (its joints, in order), got a model of task '" + motion_task + "'");
 }
 
+// How far a motion's feet slid, measured by replaying it (task/foot_slip.h); the feet
+// are those of its task's character.
+FootSlip motion_foot_slip(const std::string& path, const std::string& task_option) {
+  const nlohmann::json motion = read_json(path);
+  const Task task = load_task(motion_task_file(path, motion, task_option));
+  return motion_file_foot_slip(path, task.character_spec);
+}
+
 // Prints the audit of a walk motion; returns false if it breaks a rule of its task.
-bool audit_walk_motion(const std::string& path, const std::string& task_option) {
+// `slip` (task/foot_slip.h) gives each step the slide of the stance it begins.
+bool audit_walk_motion(const std::string& path, const std::string& task_option, const FootSlip* slip) {
   const nlohmann::json motion = read_json(path);
   if (!motion.contains("summary") || !motion["summary"].contains("walk_steps")) return true;
   const Task task = load_task(motion_task_file(path, motion, task_option));
@@ -147,30 +158,35 @@ bool audit_walk_motion(const std::string& path, const std::string& task_option) 
   const WalkAudit a = audit_walk(model->get(), record, body, task.walk);
   std::printf("walk audit (%s, from foot contacts): %zu steps, %d re-landings of a foot\n", task.name.c_str(),
               a.steps.size(), a.relandings);
-  std::printf("  step  leg    time   forward   lateral   tilt  heading\n");
+  std::printf("  step  leg    time   forward   lateral   tilt  heading  footprint  stance slide\n");
   for (size_t k = 0; k < a.steps.size(); ++k) {
     const WalkAudit::Step& s = a.steps[k];
-    std::printf("  %4zu  %s  %6.3f  %7.3f m %7.3f m %5.1f°  %6.1f°%s\n", k + 1, s.leg == 0 ? "left " : "right",
-                s.time, s.forward, s.lateral, s.tilt * 180 / M_PI, s.heading * 180 / M_PI,
+    // The landing foot's stance that begins at this touch-down.
+    std::string slid = "     -";
+    if (slip != nullptr) {
+      for (const FootSlip::Stance& st : slip->sides[static_cast<size_t>(s.leg)].stances) {
+        if (std::fabs(st.begin - s.time) < 0.5 * record.timestep) {
+          char buffer[32];
+          std::snprintf(buffer, sizeof buffer, "%6.2f cm", 100 * st.slide);
+          slid = buffer;
+        }
+      }
+    }
+    std::printf("  %4zu  %s  %6.3f  %7.3f m %7.3f m %5.1f°  %6.1f°  %7.3f m  %s%s\n", k + 1,
+                s.leg == 0 ? "left " : "right", s.time, s.forward, s.lateral, s.tilt * 180 / M_PI,
+                s.heading * 180 / M_PI, s.footprint_forward, slid.c_str(),
                 static_cast<int>(k) < task.walk.settle_steps ? "  (settling)" : "");
   }
-  std::printf("  evaluated steps: forward %.3f to %.3f m, lateral %.3f to %.3f m, tilt at most %.1f°, turn %.1f°\n",
-              a.forward_min, a.forward_max, a.lateral_min, a.lateral_max, a.max_tilt * 180 / M_PI,
-              a.turn * 180 / M_PI);
+  std::printf("  evaluated steps: forward %.3f to %.3f m (footprint to footprint %.3f to %.3f m), lateral %.3f to "
+              "%.3f m, tilt at most %.1f°, turn %.1f°\n",
+              a.forward_min, a.forward_max, a.footprint_forward_min, a.footprint_forward_max, a.lateral_min,
+              a.lateral_max, a.max_tilt * 180 / M_PI, a.turn * 180 / M_PI);
   if (a.violations.empty()) {
     std::printf("  meets the walk rules of %s\n", task.name.c_str());
     return true;
   }
   for (const std::string& v : a.violations) std::fprintf(stderr, "diverse: walk audit: %s\n", v.c_str());
   return false;
-}
-
-// How far a motion's feet slid, measured by replaying it (task/foot_slip.h); the feet
-// are those of its task's character.
-FootSlip motion_foot_slip(const std::string& path, const std::string& task_option) {
-  const nlohmann::json motion = read_json(path);
-  const Task task = load_task(motion_task_file(path, motion, task_option));
-  return motion_file_foot_slip(path, task.character_spec);
 }
 
 void print_foot_slip(const FootSlip& slip) {
@@ -278,13 +294,15 @@ void install(CLI::App& app) {
     // The feet are the task's character's: a motion without a task file to find (made by
     // another program) is replayed and checked without them.
     const nlohmann::json motion = read_json(*path);
+    std::optional<FootSlip> slip;
     if (!task->empty() || task_file_exists(*path, motion)) {
-      print_foot_slip(motion_foot_slip(*path, *task));
+      slip = motion_foot_slip(*path, *task);
+      print_foot_slip(*slip);
     } else {
       std::printf("foot slip: not measured (no task file for task '%s'; give it with --task FILE)\n",
                   motion.value("task", std::string()).c_str());
     }
-    if (!audit_walk_motion(*path, *task)) failed = true;
+    if (!audit_walk_motion(*path, *task, slip ? &*slip : nullptr)) failed = true;
     if (failed) std::exit(1);
   });
 }

@@ -64,6 +64,7 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
   std::array<bool, 2> down{true, true};
   std::array<double, 2> lifted{0, 0};           // time each foot last left the ground
   int last_leg = -1;
+  std::array<std::array<double, 2>, 2> footprint{};  // each foot's body origin at its last touch-down
   double airborne_since = -1;
   double heading = 0, start_heading = 0, last_yaw = 0, tilt = 0;
   bool first = true;
@@ -85,6 +86,9 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
     last_yaw = yaw;
     tilt = std::max({tilt, tilt_of(d, body.root_body, root_up), torso >= 0 ? tilt_of(d, torso, torso_up) : 0.0});
 
+    if (s == 0) {
+      for (size_t f = 0; f < 2; ++f) footprint[f] = {d->xpos[3 * body.feet[f]], d->xpos[3 * body.feet[f] + 1]};
+    }
     std::array<bool, 2> now{false, false};
     for (int c = 0; c < d->ncon; ++c) {
       const mjContact& con = d->contact[c];
@@ -126,12 +130,16 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
           step.time = t;
           step.forward = std::cos(yaw) * dx + std::sin(yaw) * dy;
           step.lateral = -std::sin(yaw) * dx + std::cos(yaw) * dy;
+          const double fx = p[0] - footprint[1 - i][0], fy = p[1] - footprint[1 - i][1];
+          step.footprint_forward = std::cos(yaw) * fx + std::sin(yaw) * fy;
+          step.footprint_lateral = -std::sin(yaw) * fx + std::cos(yaw) * fy;
           step.heading = heading;
           step.tilt = tilt;
           a.steps.push_back(step);
           tilt = 0;
           last_leg = f;
         }
+        footprint[i] = {p[0], p[1]};
       }
       down[i] = now[i];
     }
@@ -154,6 +162,7 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
     const int last = std::min(taken, walk.steps) - 1;
     a.forward_min = a.forward_max = a.steps[static_cast<size_t>(first_eval)].forward;
     a.lateral_min = a.lateral_max = a.steps[static_cast<size_t>(first_eval)].lateral;
+    a.footprint_forward_min = a.footprint_forward_max = a.steps[static_cast<size_t>(first_eval)].footprint_forward;
     const double tilt_limit = walk.max_tilt_deg * M_PI / 180;
     for (int k = first_eval; k <= last; ++k) {
       const WalkAudit::Step& st = a.steps[static_cast<size_t>(k)];
@@ -161,6 +170,8 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
       a.forward_max = std::max(a.forward_max, st.forward);
       a.lateral_min = std::min(a.lateral_min, st.lateral);
       a.lateral_max = std::max(a.lateral_max, st.lateral);
+      a.footprint_forward_min = std::min(a.footprint_forward_min, st.footprint_forward);
+      a.footprint_forward_max = std::max(a.footprint_forward_max, st.footprint_forward);
       a.max_tilt = std::max(a.max_tilt, st.tilt);
       if (std::fabs(st.forward - walk.forward_center) > walk.forward_half_width) {
         a.violations.push_back(format("step %.0f: forward %.3f m, expected %.2f +- %.2f", k + 1, st.forward,

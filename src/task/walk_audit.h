@@ -10,7 +10,8 @@
 // air, alternating feet (a foot that lands twice in a row is a stumble, not a step, and is
 // counted in `relandings`). A step's length is where the landing foot's body origin is,
 // minus where the other foot's is at that moment, in the heading frame of the root at
-// the landing (its forward axis turned onto the ground, lateral to its left). Tilt is the
+// the landing (its forward axis turned onto the ground, lateral to its left); the step
+// from footprint to footprint is reported beside it (Step::footprint_forward). Tilt is the
 // angle of the root's and the torso's standing "up" from world vertical (the torso: the
 // body of the deepest centre waist hinge), the largest since the previous step. A fall is any contact of a non-foot geom of the character with
 // something that is not the character; a walk never has both feet off the ground for
@@ -39,6 +40,11 @@ struct WalkAudit {
     int sim_step = 0;     // index into the record
     double time = 0;      // s
     double forward = 0, lateral = 0;  // m
+    // m: footprint to footprint, as a person measures a step: where the landing foot's
+    // body origin is, minus where the other foot's was when it last touched down (its
+    // footprint), in the same heading frame. Differs from forward/lateral by how far the
+    // other foot slid or rolled while it was down (task/foot_slip.h).
+    double footprint_forward = 0, footprint_lateral = 0;
     double heading = 0;   // rad, unwrapped, relative to standing
     double tilt = 0;      // rad, largest pelvis/torso tilt since the previous step
   };
@@ -52,6 +58,7 @@ struct WalkAudit {
   double turn = 0;              // rad, largest |heading - start heading| at a touch-down
   double max_tilt = 0;          // rad, over the evaluated steps
   double forward_min = 0, forward_max = 0, lateral_min = 0, lateral_max = 0;  // evaluated
+  double footprint_forward_min = 0, footprint_forward_max = 0;                 // evaluated
   std::vector<std::string> violations;  // empty: the walk meets the rules
 };
 
