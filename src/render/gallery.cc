@@ -547,10 +547,11 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
                        {"status", m.status()},
                        {"duration", m.duration()},
                        {"frames", body_frames_json(m.model->get(), sampled[i])}});
-    // Effort and distance from M0, and whether the motion keeps the run's bounds.
+    // Effort and distance from M0, whether the motion keeps the run's bounds, and how far
+    // its planted feet slide (task/foot_slip.h).
     if (s.contains("motions") && s["motions"].is_array() && i < s["motions"].size() &&
         s["motions"][i].is_object())
-      for (const char* key : {"effort", "effort_ratio", "positive_work", "distance_to_m0", "within_bounds"})
+      for (const char* key : {"effort", "effort_ratio", "positive_work", "distance_to_m0", "within_bounds", "foot_slip"})
         if (s["motions"][i].contains(key)) motions.back()[key] = s["motions"][i][key];
   }
   nlohmann::json strips = nlohmann::json::array();

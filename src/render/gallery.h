@@ -27,6 +27,7 @@
 //     step of each), D of the current set, D of the best set so far, and every motion's
 //     constraint value C and dmin; at most max_progress_points generations, thinned evenly;
 //   - for a run whose bodies varied, every motion's link-length scales (summary.json);
+//   - every motion's foot slip (summary.json, task/foot_slip.h), for runs that have it;
 //   - every motion's shares of the robustness suite (robust/robustness.h), over all and
 //     by kind, from RUN/robustness.json, or from summary.json "robustness" without it;
 //     null (and a note) for a run with neither, made before every run ended with the

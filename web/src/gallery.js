@@ -46,6 +46,21 @@ function percent(held, count) {
   const r = Math.round(x);
   return r - x === 0.5 && r % 2 !== 0 ? r - 1 : r;
 }
+// ---------------------------------------------------------------- foot slip
+
+// One motion's foot slip (summary.json motions[i].foot_slip, task/foot_slip.h) as a table
+// cell: the worst stance's slide in cm, per side in the title.
+function slipCell(f) {
+  if (!f) return el('td', { class: 'slip self', title: 'foot slip not measured on this motion' }, 'n/a');
+  const cm = (v) => (100 * v).toFixed(1);
+  const side = (name) => {
+    const s = f[name] || {};
+    return `${name}: ${s.stances} stances, ${cm(s.mean_per_stance)} cm per stance on average, ` +
+      `${cm(s.largest_per_stance)} cm at most, up to ${Number(s.max_speed).toFixed(2)} m/s`;
+  };
+  return el('td', { class: 'slip', title: `${side('left')}; ${side('right')}` }, `${cm(f.largest_per_stance)} cm`);
+}
+
 // One motion's shares (data.robustness.motions[i]) as "holds 5 of 19 (26 %)" and "params
 // 0/8, pushes 4/8, friction 0/2, half-step 1/1"; null when the suite was not run on it.
 function robustnessOf(i) {
@@ -127,9 +142,11 @@ function fillDistances() {
     const bounds = (data.run || {}).bounds || {};
     const hasEffort = data.motions.some((m) => typeof m.effort_ratio === 'number');
     const hasRobustness = Boolean(data.robustness);
+    const hasSlip = data.motions.some((m) => m.foot_slip);
     head.append(el('th', {}, ''), el('th', {}, 'C'));
     if (hasEffort) head.append(el('th', { title: 'control effort relative to M0\'s' }, 'effort'));
     if (hasRobustness) head.append(el('th', { title: 'the share of the robustness suite\'s perturbed rollouts that still meet the task' }, 'holds'));
+    if (hasSlip) head.append(el('th', { title: 'how far a planted foot slid in its worst stance' }, 'slide'));
     for (const l of labels) head.append(el('th', {}, l));
     table.append(head);
     const d = dist[current] || [];
@@ -152,6 +169,7 @@ function fillDistances() {
         row.append(r ? el('td', { class: 'robust', title: `${r.total}: ${r.kinds}` }, `${r.percent} %`)
           : el('td', { class: 'robust self', title: 'the robustness suite was not run on this motion' }, 'n/a'));
       }
+      if (hasSlip) row.append(slipCell(m.foot_slip));
       const others = (d[i] || []).filter((_, j) => j !== i);
       const min = Math.min(...others);
       (d[i] || []).forEach((v, j) => {
@@ -172,7 +190,8 @@ function fillDistances() {
       ((data.run || {}).bounds && Object.keys(data.run.bounds).length ? ' and every bound is kept' : '') + '.' +
       (hasEffort ? ' Effort: the time integral of the squared joint torques, as a multiple of M0\'s' +
         (bounds.effort !== undefined ? ' (red: over the bound)' : '') + '.' : '') +
-      (hasRobustness ? ' Holds: the share of the robustness suite\'s perturbed rollouts that still meet the task.' : '');
+      (hasRobustness ? ' Holds: the share of the robustness suite\'s perturbed rollouts that still meet the task.' : '') +
+      (hasSlip ? ' Slide: how far a planted foot slid in its worst stance (cm), measured by replaying the motion.' : '');
     for (const b of $('metric-tabs').children) b.setAttribute('aria-selected', String(b.dataset.metric === current));
   };
   for (const m of metrics) {

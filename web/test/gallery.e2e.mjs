@@ -387,6 +387,22 @@ try {
       'and says how to run it', `${robustShown.notes} | ${robustShown.help}`);
   }
 
+  // ---------------------------------------------------------------- foot slip
+
+  // Every motion's worst stance's slide (summary.json motions[i].foot_slip) in the distance
+  // table, per side in its title; a run without the measure has no such column.
+  const slipShown = await page.evaluate(() =>
+    [...document.querySelectorAll('#distances td.slip')].map((t) => ({ text: t.textContent, title: t.title })));
+  const slips = (summary.motions || []).map((m) => m.foot_slip);
+  if (slips.some(Boolean)) {
+    check(slipShown.length === data.motions.length && slips.every((f, i) =>
+      f && slipShown[i].text === `${(100 * f.largest_per_stance).toFixed(1)} cm` &&
+      slipShown[i].title.includes(`left: ${f.left.stances} stances`)),
+    'the distance table shows every motion\'s foot slip', JSON.stringify(slipShown));
+  } else {
+    check(slipShown.length === 0, 'a run without the foot-slip measure has no slide column', JSON.stringify(slipShown));
+  }
+
   await page.locator('#time').fill('500');
   await settle();
   await page.screenshot({ path: join(runDir, 'gallery-screenshot.png'), fullPage: true });
