@@ -211,6 +211,10 @@ void install_foot_slip(CLI::App& app) {
   cmd->add_option("paths", *paths, "Motion files (motion.json) and run directories")->required();
   cmd->add_option("--task", *task, "Task file whose character's feet are measured (default: the run's, else tasks/<task>.toml)");
   cmd->add_flag("--json", *json, "Print JSON (per motion: file, label and the measure) instead of a table");
+  cmd->footer("Examples:\n"
+              "  diverse foot-slip runs/robot_silly_walk            every motion of a run\n"
+              "  diverse foot-slip out/motion.json --json           one motion of `diverse simulate`\n"
+              "Definition: docs/reference/foot-slip.md");
   cmd->callback([paths, task, json] {
     std::vector<std::string> files;
     for (const std::string& p : *paths) {
@@ -257,12 +261,12 @@ void install(CLI::App& app) {
   auto path = std::make_shared<std::string>();
   auto task = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
-      "replay", "Replay a motion record in plain MuJoCo, compare qpos and check net joint torques");
+      "replay", "Replay a motion record in plain MuJoCo, compare qpos, check net joint torques and measure foot slip");
   cmd->footer("Example:\n"
               "  diverse replay runs/jump_high/motions/m1.json");
   cmd->add_option("motion", *path, "motion.json written by simulate or run")->required();
   cmd->add_option("--task", *task,
-                  "Task file whose [walk] rules a walk is audited against (default: the run's, else tasks/<task>.toml)");
+                  "Task file whose character's feet are measured and whose [walk] rules a walk is audited against (default: the run's, else tasks/<task>.toml)");
   cmd->callback([path, task] {
     if (!task->empty()) check_task_of_motion(*path, *task);
     int steps = 0;
