@@ -65,7 +65,7 @@ NetTorqueCheck check_motion_torques(const std::string& path, std::string* worst_
 
 // The task file of a motion: `given`, else the run's, else tasks/<name>.toml.
 std::string motion_task_file(const std::string& motion_path, const nlohmann::json& motion, const std::string& given) {
-  if (!given.empty()) return given;
+  if (!given.empty()) return resolve_task_path(given);
   const std::filesystem::path run_json = std::filesystem::path(motion_path).parent_path().parent_path() / "run.json";
   if (std::filesystem::exists(run_json)) {
     const nlohmann::json run = read_json(run_json);
