@@ -57,7 +57,9 @@ SkillValue read_value(const TomlReader& parent, const std::string& key, const to
   std::vector<const char*> known = {"param", "value", "curve", "range", "unit"};
   known.insert(known.end(), extra.begin(), extra.end());
   for (const auto& [k, node] : *t) {
-    if (std::find_if(known.begin(), known.end(), [&](const char* s) { return k.str() == s; }) == known.end()) {
+    // A named copy: clang before 16 does not let a lambda capture a structured binding.
+    const std::string_view key_name = k.str();
+    if (std::find_if(known.begin(), known.end(), [&](const char* s) { return key_name == s; }) == known.end()) {
       std::string list;
       for (const char* s : known) list += std::string(list.empty() ? "" : ", ") + s;
       r.fail(std::string(k.str()), "expected no such key (unknown key; known keys: " + list + ")");
