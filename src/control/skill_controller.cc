@@ -197,6 +197,16 @@ void SkillController::reset(const mjModel* m, const mjData* d) {
     state_.from[i] = to_world(i, d->qpos, state_.target[i]);
   }
   const SkillPhaseBinding& pb = binding_->phases[0];
+  load_goals(pb);
+  state_.phase_begin = d->time;
+  state_.phase_duration = duration_of(0);
+  state_.phase_changed = false;
+  times_.begin[0] = d->time;
+  for (int k : pb.modules) modules_[static_cast<size_t>(k)]->enter(m, d, state_);
+}
+
+// A phase's goal targets and gains: its numbers, or the motion's values of its parameters.
+void SkillController::load_goals(const SkillPhaseBinding& pb) {
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const SkillJointTarget& t = pb.targets[i];
     state_.goal[i] = t.param >= 0 ? values_[static_cast<size_t>(t.param)] : t.value->number;
@@ -204,11 +214,6 @@ void SkillController::reset(const mjModel* m, const mjData* d) {
     state_.kp[i] = g.kp_param >= 0 ? values_[static_cast<size_t>(g.kp_param)] : g.kp;
     state_.kd[i] = g.kd_param >= 0 ? values_[static_cast<size_t>(g.kd_param)] : g.kd;
   }
-  state_.phase_begin = d->time;
-  state_.phase_duration = duration_of(0);
-  state_.phase_changed = false;
-  times_.begin[0] = d->time;
-  for (int k : pb.modules) modules_[static_cast<size_t>(k)]->enter(m, d, state_);
 }
 
 void SkillController::enter(int phase, const mjModel* m, const mjData* d) {
@@ -222,13 +227,7 @@ void SkillController::enter(int phase, const mjModel* m, const mjData* d) {
   // the last joint target implies for the tracked link in the current pose.
   for (size_t i = 0; i < body_.joints.size(); ++i) state_.from[i] = to_world(i, q, state_.target[i]);
   const SkillPhaseBinding& pb = binding_->phases[static_cast<size_t>(phase)];
-  for (size_t i = 0; i < body_.joints.size(); ++i) {
-    const SkillJointTarget& jt = pb.targets[i];
-    state_.goal[i] = jt.param >= 0 ? values_[static_cast<size_t>(jt.param)] : jt.value->number;
-    const SkillJointGain& g = pb.gains[i];
-    state_.kp[i] = g.kp_param >= 0 ? values_[static_cast<size_t>(g.kp_param)] : g.kp;
-    state_.kd[i] = g.kd_param >= 0 ? values_[static_cast<size_t>(g.kd_param)] : g.kd;
-  }
+  load_goals(pb);
   if (phase == takeoff_) {
     state_.takeoff_com_z = state_.com[2];
     takeoff_pitch_ = q[body_.root_pitch_qpos];

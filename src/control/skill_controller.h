@@ -95,6 +95,7 @@ class SkillController : public Controller {
  private:
   bool holds(const SkillCondition& c, const mjModel* m, const mjData* d) const;
   void enter(int phase, const mjModel* m, const mjData* d);
+  void load_goals(const SkillPhaseBinding& pb);
   double duration_of(int phase) const;
   double to_local(size_t j, const double* qpos, double world) const;
   double to_world(size_t j, const double* qpos, double local) const;
