@@ -75,7 +75,7 @@ std::string condition_text(const SkillCondition& c) {
   if (c.kind == "time") std::snprintf(text, sizeof text, "time %g s", c.after);
   else if (c.kind == "liftoff") std::snprintf(text, sizeof text, "liftoff (%g s without contact, COM rising)", c.airborne);
   else if (c.kind == "turned") std::snprintf(text, sizeof text, "turned %g rad", c.angle);
-  else if (c.kind == "contact_made" || c.kind == "contact_lost") std::snprintf(text, sizeof text, "%s %s", c.kind.c_str(), c.body.c_str());
+  else if (c.kind == "contact_made" || c.kind == "contact_lost") std::snprintf(text, sizeof text, "%s %s", c.kind.c_str(), c.body.empty() ? ("of the " + c.foot + " foot").c_str() : c.body.c_str());
   else if (c.kind == "feature") std::snprintf(text, sizeof text, "%s %s %g", c.feature.c_str(), c.above ? ">=" : "<=", c.threshold);
   else return c.kind;
   return text;
@@ -92,11 +92,13 @@ void show(const Bound& b) {
               s.landing.empty() ? "-" : s.landing.c_str());
   for (const SkillModuleSpec& m : s.modules) {
     std::printf("  module %s (%s):", m.name.c_str(), m.kind.c_str());
+    for (const auto& [name, word] : m.words) std::printf(" %s = %s;", name.c_str(), word.c_str());
     for (const auto& [name, value] : m.settings) std::printf(" %s = %s;", name.c_str(), value_text(value).c_str());
     std::printf("\n");
   }
   for (const SkillPhase& p : s.phases) {
-    std::printf("  phase %s: targets %s, gains %s, ", p.name.c_str(), p.targets.c_str(),
+    std::printf("  phase %s: %s%stargets %s, gains %s, ", p.name.c_str(), p.swing < 0 ? "" : p.swing == 0 ? "the left leg swings, " : "the right leg swings, ",
+                p.parameters.empty() ? "" : ("parameters " + p.parameters + ".*, ").c_str(), p.targets.c_str(),
                 p.gains.empty() ? "the character's" : p.gains.c_str());
     if (p.duration.kind == SkillDuration::Kind::kValue) std::printf("duration %s", value_text(p.duration.value).c_str());
     else if (p.duration.kind == SkillDuration::Kind::kPredict) std::printf("duration predicted (%s)", p.duration.predict.c_str());

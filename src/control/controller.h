@@ -99,9 +99,12 @@ class ControllerType {
   virtual ~ControllerType() = default;
   virtual const char* name() const = 0;         // the task file's [controller] type
   virtual const char* description() const = 0;  // one line, for messages and docs
-  // The kind of skill: "jump" (the default) or "walk"; a walk task (task/walk_task.h) needs
-  // a walk controller and the other way round.
-  virtual const char* skill() const { return "jump"; }
+  // The kind of skill `config` makes: "jump" (the default) or "walk"; a walk task
+  // (task/walk_task.h) needs a walk controller and the other way round.
+  virtual const char* skill(const ControllerConfig& config) const {
+    (void)config;
+    return "jump";
+  }
   // Parses the [controller] table's own keys ("type" is read already; reject unknown
   // keys with r.only()). Throws UserError naming the file and field.
   virtual std::shared_ptr<const ControllerConfig> read_config(const TomlReader& r) const = 0;

@@ -7,12 +7,21 @@
 
 #include "control/module_balance.h"
 #include "control/module_foot_placement.h"
+#include "control/module_gravity_compensation.h"
+#include "control/module_simbicon.h"
 #include "control/module_spotting.h"
 #include "control/module_stance.h"
+#include "control/module_stance_hip.h"
+#include "control/module_stance_support.h"
 #include "core/error.h"
 #include "core/toml_reader.h"
+#include "physics/model.h"
 
 namespace diverse {
+
+namespace {
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+}  // namespace
 
 double skill_wrap(double a) { return std::fabs(a) <= M_PI ? a : std::remainder(a, 2 * M_PI); }
 
@@ -73,6 +82,11 @@ std::shared_ptr<const ControllerConfig> SkillControllerType::read_config(const T
   return c;
 }
 
+const char* SkillControllerType::skill(const ControllerConfig& config) const {
+  const auto* c = dynamic_cast<const SkillConfig*>(&config);
+  return c != nullptr && c->skill->walk ? "walk" : "jump";
+}
+
 void SkillControllerType::check(const Character& body, const std::string& task_file) const {
   (void)body;
   (void)task_file;  // bound (and checked) with the parameters, against the character's model
@@ -118,6 +132,99 @@ SkillController::SkillController(const Character& body, const SkillConfig& confi
   times_.rise = takeoff_;
   times_.fall = skill_->phase_index(skill_->peak);
   times_.land = skill_->phase_index(skill_->landing);
+  state_.u.assign(n, 0.0);
+  state_.damping.assign(n, 0.0);
+  preset_.assign(n, 0);
+  for (const SkillPhaseBinding& pb : binding_->phases) {
+    heading_frame_ = heading_frame_ || pb.root;
+    for (const SkillJointTarget& t : pb.targets) heading_frame_ = heading_frame_ || t.world == SkillTarget::World::kHeading;
+  }
+}
+
+void SkillController::prepare(const mjModel* m) {
+  if (prepared_ || !heading_frame_) return;
+  prepared_ = true;
+  standing_ = standing_frames(m, body_.root_body);
+  state_.standing = &standing_;
+  links_.assign(static_cast<size_t>(m->nbody), HeadingLink{});
+  for (const CharacterJoint& j : body_.joints) {
+    HeadingLink& link = links_[static_cast<size_t>(j.body)];
+    if (link.body < 0) link = heading_link(body_, m, standing_, j.body);
+  }
+  link_done_.assign(static_cast<size_t>(m->nbody), 0);
+  link_error_.assign(static_cast<size_t>(m->nbody), {0, 0, 0});
+}
+
+void SkillController::link_target(int b, double* quat) const {
+  const HeadingLink& link = links_[static_cast<size_t>(b)];
+  double angles[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (size_t i = 0; i < link.joints.size() && i < 8; ++i) angles[i] = state_.target[static_cast<size_t>(link.joints[i])];
+  heading_link_target(link, state_.heading, angles, quat);
+}
+
+bool SkillController::start_state(const mjModel* m, mjData* d) {
+  if (!skill_->start_pose) return false;
+  prepare(m);
+  const SkillPhaseBinding& pb = binding_->phases[0];
+  load_goals(pb);
+  state_.heading = 0;
+  const int stance = pb.swing >= 0 ? 1 - pb.swing : -1;
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  mju_zero(d->qvel, m->nv);
+  if (pb.root) heading_root_target(standing_, 0, state_.root_pitch, state_.root_roll, d->qpos + body_.root_qpos + 3);
+  const size_t n = body_.joints.size();
+  for (size_t i = 0; i < n; ++i) {
+    state_.target[i] = state_.goal[i];
+    if (pb.targets[i].world == SkillTarget::World::kJoint) d->qpos[body_.joints[i].qpos] = state_.goal[i];
+  }
+  // The links at their targets (the stance foot at its standing orientation), by
+  // fixed-point iteration on the hinge angles, each turned by the error's component along
+  // its axis.
+  std::vector<std::pair<const HeadingLink*, std::vector<double>>> goals;
+  for (const HeadingLink& link : links_) {
+    if (link.body < 0) continue;
+    const bool stance_foot = stance >= 0 && link.body == body_.feet[static_cast<size_t>(stance)];
+    bool tracked = false;
+    for (int k : link.joints) tracked = tracked || pb.targets[static_cast<size_t>(k)].world == SkillTarget::World::kHeading;
+    if (!tracked && !stance_foot) continue;
+    std::vector<double> angles(link.joints.size(), 0.0);
+    if (!stance_foot) {
+      for (size_t i = 0; i < link.joints.size(); ++i) angles[i] = state_.goal[static_cast<size_t>(link.joints[i])];
+    }
+    goals.emplace_back(&link, angles);
+  }
+  for (int it = 0; it < 50; ++it) {
+    mj_kinematics(m, d);
+    double worst = 0;
+    for (const auto& [link, angles] : goals) {
+      double target[4], e[3];
+      heading_link_target(*link, 0, angles.data(), target);
+      rotation_error(target, d->xquat + 4 * link->body, e);
+      worst = std::max(worst, mju_norm3(e));
+      for (int k : link->joints) {
+        const CharacterJoint& j = body_.joints[static_cast<size_t>(k)];
+        double& q = d->qpos[j.qpos];
+        q += dot3(d->xaxis + 3 * j.joint, e);
+        if (std::isfinite(j.lower)) q = std::clamp(q, j.lower, j.upper);
+      }
+    }
+    if (worst < 1e-10) break;
+  }
+  // The stance sole (or, without a swing leg, both) on the floor, the root above the origin.
+  mj_kinematics(m, d);
+  double lowest = INFINITY;
+  for (int g = 0; g < m->ngeom; ++g) {
+    int side = -1;
+    if (m->geom_bodyid[g] == 0 || !body_.is_foot_geom(m, g, &side) || (stance >= 0 && side != stance)) continue;
+    double lo = 0, hi = 0;
+    geom_z_extent(m, d, g, &lo, &hi);
+    lowest = std::min(lowest, lo);
+  }
+  if (std::isfinite(lowest)) d->qpos[body_.root_qpos + 2] -= lowest;
+  d->qpos[body_.root_qpos] = 0;
+  d->qpos[body_.root_qpos + 1] = 0;
+  mj_kinematics(m, d);
+  return true;
 }
 
 SkillTarget::World SkillController::world(size_t j) const {
@@ -173,6 +280,7 @@ double SkillController::duration_of(int phase) const {
 }
 
 void SkillController::reset(const mjModel* m, const mjData* d) {
+  prepare(m);
   com_velocity_ = SubtreeComVelocity(m, body_.root_body);
   state_.gravity = -m->opt.gravity[2];
   state_.time = d->time;
@@ -207,9 +315,19 @@ void SkillController::reset(const mjModel* m, const mjData* d) {
 
 // A phase's goal targets and gains: its numbers, or the motion's values of its parameters.
 void SkillController::load_goals(const SkillPhaseBinding& pb) {
+  auto value = [&](const SkillJointTarget& t) {
+    const double v = t.param >= 0 ? values_[static_cast<size_t>(t.param)] : t.value->number;
+    return t.sign == 1 ? v : t.sign * v;
+  };
+  state_.swing = pb.swing;
+  state_.root = pb.root;
+  if (pb.root) {
+    state_.root_pitch = value(pb.root_pitch);
+    state_.root_roll = value(pb.root_roll);
+  }
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const SkillJointTarget& t = pb.targets[i];
-    state_.goal[i] = t.param >= 0 ? values_[static_cast<size_t>(t.param)] : t.value->number;
+    state_.goal[i] = value(t);
     const SkillJointGain& g = pb.gains[i];
     state_.kp[i] = g.kp_param >= 0 ? values_[static_cast<size_t>(g.kp_param)] : g.kp;
     state_.kd[i] = g.kd_param >= 0 ? values_[static_cast<size_t>(g.kd_param)] : g.kd;
@@ -255,6 +373,13 @@ bool SkillController::holds(const SkillCondition& c, const mjModel* m, const mjD
       if (skill_->modules[static_cast<size_t>(mod)].kind == "spotting" && modules_[static_cast<size_t>(mod)]->spotted(state_)) return true;
     }
     return false;
+  }
+  if ((k == "contact_made" || k == "contact_lost") && !c.foot.empty()) {
+    // A foot (or a body below it) by side, or by its role in the phase.
+    const int swing = state_.swing;
+    const int side = c.foot == "left" ? 0 : c.foot == "right" ? 1 : c.foot == "swing" ? swing : 1 - swing;
+    const bool touching = contacts_.foot[static_cast<size_t>(side)];
+    return k == "contact_made" ? touching : !touching;
   }
   if (k == "contact_made" || k == "contact_lost") {
     int id = -1;
@@ -326,6 +451,8 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
   const bool at_once = !now.interpolate || now.duration.kind == SkillDuration::Kind::kNone;
   const double s = at_once ? 1.0 : std::clamp((t - state_.phase_begin) / std::max(state_.phase_duration, 1e-6), 0.0, 1.0);
   state_.progress = s;
+  if (heading_frame_) state_.heading = root_heading(d, root, standing_);
+  state_.double_support = pb.swing >= 0 && !pb.swing_lands && contacts.foot[static_cast<size_t>(pb.swing)];
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     bool skip = false;
     for (int k : pb.modules) skip = skip || modules_[static_cast<size_t>(k)]->owns_target(static_cast<int>(i));
@@ -342,6 +469,10 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
       continue;
     }
     const double goal = state_.goal[i];
+    if (jt.world == SkillTarget::World::kHeading) {  // at once: angles from standing
+      state_.target[i] = goal;
+      continue;
+    }
     // World pitches along the shorter way round, then a joint target for the current pose.
     const double step = tracked ? skill_wrap(goal - state_.from[i]) : goal - state_.from[i];
     state_.target[i] = tracked ? to_local(i, q, state_.from[i] + s * step) : state_.from[i] + s * step;
@@ -362,12 +493,32 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
   // (the drive's damping) plus kd times the rate of the link on the other side of the
   // joint, with the sign that makes the sum the tracked link's rate.
   const double* v = d->qvel;
+  if (heading_frame_) std::fill(link_done_.begin(), link_done_.end(), 0);
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const CharacterJoint& j = body_.joints[i];
     // The strength model scales every joint's PD gains (Character::strength).
     const double kp = body_.strength * state_.kp[i];
     const double kd = body_.strength * state_.kd[i];
     const SkillTarget::World w = pb.targets[i].world;
+    preset_[i] = 0;
+    if (w == SkillTarget::World::kHeading) {
+      // The link below the joint tracks its heading-frame orientation: the rotation error e
+      // (world) projected on the hinge's axis a, tau = kp a . e - kd a . w_link, the
+      // derivative part split into the joint's own rate (the drive's damping) and
+      // a . w_parent.
+      const size_t b = static_cast<size_t>(j.body);
+      if (!link_done_[b]) {
+        double target[4];
+        link_target(j.body, target);
+        rotation_error(target, d->xquat + 4 * j.body, link_error_[b].data());
+        link_done_[b] = 1;
+      }
+      const double* a = d->xaxis + 3 * j.joint;
+      const double* w_parent = d->cvel + 6 * m->body_parentid[j.body];
+      state_.u[i] = kp * dot3(a, link_error_[b].data()) - kd * dot3(a, w_parent) + state_.feedforward[i];
+      state_.damping[i] = kd;
+      continue;
+    }
     if (w != SkillTarget::World::kJoint && drive.damping() == Damping::kConstrained) {
       // The drive damps the tracked link's world pitch rate itself: root pitch rate plus
       // the joint rates down the chain to the child; the parent's is that less qdot.
@@ -377,6 +528,7 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
       for (int k : body_.chain(static_cast<int>(i))) damped_.push_back({body_.joints[static_cast<size_t>(k)].dof, sign});
       if (w == SkillTarget::World::kParent) damped_.push_back({j.dof, 1.0});
       drive.set(static_cast<int>(i), kp * (state_.target[i] - q[j.qpos]) + state_.feedforward[i], kd, damped_);
+      preset_[i] = 1;
       continue;
     }
     double world_damping = 0;
@@ -388,8 +540,12 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
         world_damping = -kd * (child_rate - v[j.dof]);
       }
     }
-    const double u = kp * (state_.target[i] - q[j.qpos]) + world_damping + state_.feedforward[i];
-    drive.set(static_cast<int>(i), u, kd);
+    state_.u[i] = kp * (state_.target[i] - q[j.qpos]) + world_damping + state_.feedforward[i];
+    state_.damping[i] = kd;
+  }
+  for (int k : pb.modules) modules_[static_cast<size_t>(k)]->adjust_torques(m, d, state_);
+  for (size_t i = 0; i < body_.joints.size(); ++i) {
+    if (!preset_[i]) drive.set(static_cast<int>(i), state_.u[i], state_.damping[i]);
   }
 }
 
@@ -419,6 +575,10 @@ std::unique_ptr<SkillModule> make_skill_module(const SkillModuleSpec& spec, cons
   if (spec.kind == "foot_placement") return std::make_unique<FootPlacementModule>(settings, body);
   if (spec.kind == "spotting") return std::make_unique<SpottingModule>(settings);
   if (spec.kind == "stance") return std::make_unique<StanceModule>(settings, body);
+  if (spec.kind == "simbicon") return std::make_unique<SimbiconModule>(spec, settings, body);
+  if (spec.kind == "gravity_compensation") return std::make_unique<GravityCompensationModule>(body);
+  if (spec.kind == "stance_support") return std::make_unique<StanceSupportModule>(settings, body);
+  if (spec.kind == "stance_hip") return std::make_unique<StanceHipModule>(settings, body);
   throw std::logic_error("skill: no module of kind " + spec.kind);
 }
 

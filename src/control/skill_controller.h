@@ -67,6 +67,7 @@ class SkillControllerType : public ControllerType {
  public:
   const char* name() const override { return "skill"; }
   const char* description() const override { return "the skill engine: runs the phases of a skill file (skills/)"; }
+  const char* skill(const ControllerConfig& config) const override;
   std::shared_ptr<const ControllerConfig> read_config(const TomlReader& r) const override;
   void check(const Character& body, const std::string& task_file) const override;
   std::vector<ParamSpec> parameter_specs(const Character& body, const ControllerConfig& config) const override;
@@ -80,6 +81,11 @@ class SkillController : public Controller {
   SkillController(const Character& body, const SkillConfig& config, std::shared_ptr<const SkillBinding> binding,
                   const std::vector<double>& values);
 
+  // With start = "first_phase" (free roots): the rollout starts static in the first
+  // phase's pose, heading along world x: the root at its pitch and roll, every joint at its
+  // target, every heading-frame link at its target (without the modules' feedback), the
+  // stance foot at its standing orientation and its sole on the floor below the root.
+  bool start_state(const mjModel* m, mjData* d) override;
   void reset(const mjModel* m, const mjData* d) override;
   void control(const mjModel* m, mjData* d, const ContactState& contacts, JointDrive& drive) override;
 
@@ -100,6 +106,9 @@ class SkillController : public Controller {
   double to_local(size_t j, const double* qpos, double world) const;
   double to_world(size_t j, const double* qpos, double local) const;
   SkillTarget::World world(size_t j) const;
+  void prepare(const mjModel* m);  // the standing frames and heading-frame links, once
+  // The world orientation target of the heading-frame link on MuJoCo body `b`.
+  void link_target(int b, double* quat) const;
 
   const Character& body_;
   std::shared_ptr<const SkillFile> skill_;
@@ -116,6 +125,14 @@ class SkillController : public Controller {
   std::vector<std::pair<const SkillCondition*, int>> bodies_;  // conditions' bodies: MuJoCo ids
   std::vector<DampedDof> damped_;  // scratch: a tracked joint's damped velocity
   SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
+  // Free roots: whether any phase tracks the root or a link in the heading frame, the
+  // model's standing frames and, per MuJoCo body, its link (body -1 when it has no hinge).
+  bool heading_frame_ = false, prepared_ = false;
+  StandingFrames standing_;
+  std::vector<HeadingLink> links_;
+  std::vector<char> link_done_;      // per MuJoCo body: its error computed this step
+  std::vector<std::array<double, 3>> link_error_;  // per MuJoCo body: rotation error (world)
+  std::vector<char> preset_;         // per joint: already given to the drive this step
 };
 
 }  // namespace diverse

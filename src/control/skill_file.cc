@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include "core/error.h"
 #include "core/toml_reader.h"
@@ -67,8 +68,8 @@ SkillValue read_value(const TomlReader& parent, const std::string& key, const to
   }
   const int forms = (r.has("param") ? 1 : 0) + (r.has("value") ? 1 : 0) + (r.has("curve") ? 1 : 0);
   if (forms != 1) {
-    // left/right tables carry their values themselves.
-    if (forms == 0 && (r.has("left") || r.has("right"))) return v;
+    // left/right (swing/stance, root pitch/roll) tables carry their values themselves.
+    if (forms == 0 && (r.has("left") || r.has("right") || r.has("swing") || r.has("stance") || r.has("pitch") || r.has("roll"))) return v;
     parent.fail(key, std::string(kValueForms) + (forms == 0 ? " (none given)" : " (only one of param, value, curve)"));
   }
   if (r.has("param")) {
@@ -95,6 +96,25 @@ SkillValue read_value(const TomlReader& parent, const std::string& key, const to
     }
     if (v.curve.front()[0] != 0 || v.curve.back()[0] != 1) r.fail("curve", expect);
   }
+  if (r.has("mirror")) v.mirror = r.boolean("mirror", false);
+  return v;
+}
+
+SkillTarget::World read_world(const TomlReader& r) {
+  const std::string world = r.string("world", "joint");
+  if (world == "parent") return SkillTarget::World::kParent;
+  if (world == "child") return SkillTarget::World::kChild;
+  if (world == "heading") return SkillTarget::World::kHeading;
+  if (world != "joint") r.fail("world", "expected \"joint\", \"parent\", \"child\" or \"heading\", got \"" + world + "\"");
+  return SkillTarget::World::kJoint;
+}
+
+// One side's value (left, right, swing, stance), which may name its own `world`.
+SkillValue read_side(const TomlReader& er, const toml::table& e, const char* key) {
+  SkillValue v = read_value(er, key, *e.get(key), {"world", "mirror"});
+  if (const toml::table* t = e.get(key)->as_table(); t != nullptr && t->contains("world")) {
+    v.world = static_cast<int>(read_world(er.sub(key, *t)));
+  }
   return v;
 }
 
@@ -105,21 +125,39 @@ void read_target_set(const TomlReader& sets, const std::string& name, const toml
     SkillTarget target;
     target.selector = std::string(k.str());
     target.line = line_of(node);
-    target.both = read_value(r, target.selector, node, {"world", "left", "right"});
+    if (target.selector == "root") {
+      // The free root's orientation in the heading frame: { pitch = VALUE, roll = VALUE }.
+      const toml::table* e = node.as_table();
+      if (e == nullptr) r.fail("root", "expected a table { pitch = VALUE, roll = VALUE }");
+      const TomlReader er = r.sub("root", *e);
+      er.only({"pitch", "roll"});
+      if (!er.has("pitch") || !er.has("roll")) er.fail(er.has("pitch") ? "roll" : "pitch", std::string(kValueForms) + " (missing)");
+      target.world = SkillTarget::World::kHeading;
+      target.pitch = read_value(er, "pitch", *e->get("pitch"), {"mirror"});
+      target.roll = read_value(er, "roll", *e->get("roll"), {"mirror"});
+      for (const SkillValue* v : {&target.pitch, &target.roll}) {
+        if (v->kind == SkillValue::Kind::kCurve) er.fail(v == &target.pitch ? "pitch" : "roll", "expected a number or a parameter (the root takes no curve)");
+      }
+      out.push_back(target);
+      continue;
+    }
+    target.both = read_value(r, target.selector, node, {"world", "left", "right", "swing", "stance", "mirror"});
     if (const toml::table* e = node.as_table()) {
       const TomlReader er = r.sub(target.selector.c_str(), *e);
-      const std::string world = er.string("world", "joint");
-      if (world == "parent") target.world = SkillTarget::World::kParent;
-      else if (world == "child") target.world = SkillTarget::World::kChild;
-      else if (world != "joint") er.fail("world", "expected \"joint\", \"parent\" or \"child\", got \"" + world + "\"");
-      if (er.has("left") || er.has("right")) {
+      target.world = read_world(er);
+      const bool lr = er.has("left") || er.has("right"), roles = er.has("swing") || er.has("stance");
+      if (lr || roles) {
+        const char* a = lr ? "left" : "swing";
+        const char* b = lr ? "right" : "stance";
         if (er.has("param") || er.has("value") || er.has("curve")) {
-          er.fail("left", "expected either one value for both sides or left and right, not both");
+          er.fail(a, std::string("expected either one value for both sides or ") + a + " and " + b + ", not both");
         }
-        if (!er.has("left") || !er.has("right")) er.fail(er.has("left") ? "right" : "left", "expected both left and right (missing)");
+        if (lr && roles) er.fail("swing", "expected either left and right or swing and stance, not both");
+        if (!er.has(a) || !er.has(b)) er.fail(er.has(a) ? b : a, std::string("expected both ") + a + " and " + b + " (missing)");
         target.sided = true;
-        target.left = read_value(er, "left", *e->get("left"));
-        target.right = read_value(er, "right", *e->get("right"));
+        target.by_role = roles;
+        target.left = read_side(er, *e, a);
+        target.right = read_side(er, *e, b);
       }
     }
     out.push_back(target);
@@ -160,7 +198,7 @@ std::string quoted_list(const std::vector<std::string>& names) {
 }
 
 SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
-  r.only({"to", "on", "passes", "gave_up", "after", "for", "angle", "body", "feature", "above", "below"});
+  r.only({"to", "on", "passes", "gave_up", "after", "for", "angle", "body", "foot", "feature", "above", "below"});
   SkillTransition tr;
   tr.line = line_of(t);
   tr.to = r.string("to");
@@ -193,8 +231,18 @@ SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
       need("angle");
       c.angle = r.number("angle", 0, 8 * M_PI);
     } else if (kind == "contact_made" || kind == "contact_lost") {
-      need("body");
-      c.body = r.string("body");
+      // A body by name, or a foot by side or by its role in the phase.
+      if (r.has("foot") == r.has("body")) r.fail("body", "expected exactly one of body = \"NAME\" or foot = \"swing\", \"stance\", \"left\" or \"right\"");
+      if (r.has("body")) {
+        need("body");
+        c.body = r.string("body");
+      } else {
+        need("foot");
+        c.foot = r.string("foot");
+        if (c.foot != "swing" && c.foot != "stance" && c.foot != "left" && c.foot != "right") {
+          r.fail("foot", "expected \"swing\", \"stance\", \"left\" or \"right\", got \"" + c.foot + "\"");
+        }
+      }
     } else if (kind == "feature") {
       need("feature");
       c.feature = r.string("feature");
@@ -208,7 +256,7 @@ SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
     }
     tr.on.push_back(c);
   }
-  for (const char* key : {"after", "for", "angle", "body", "feature", "above", "below"}) {
+  for (const char* key : {"after", "for", "angle", "body", "foot", "feature", "above", "below"}) {
     if (r.has(key) && used.count(key) == 0) r.fail(key, "expected no such setting for the conditions " + quoted_list(kinds));
   }
   return tr;
@@ -263,6 +311,15 @@ const std::vector<SkillModuleKind>& skill_module_kinds() {
        "spotting the landing: the `spotted` condition holds when the body, opened now, turns `turn` by touch-down"},
       {"stance", {}, {"offset", "stand_after", "stand_duration"},
        "stance control: COM force kept inside the soles, pelvis, chest and feet in world pitch"},
+      {"simbicon", {"cd", "cv"}, {},
+       "SIMBICON balance: the swing hip's target in one plane plus cd d + cv v (Yin, Loken, van de Panne 2007)",
+       {{"plane", {"sagittal", "coronal"}}}},
+      {"gravity_compensation", {}, {},
+       "every joint off the legs in stance holds the links it carries against gravity"},
+      {"stance_support", {"support"}, {},
+       "the stance leg's knee and the joints below it carry `support` times the weight, J^T of an upward force on the COM"},
+      {"stance_hip", {}, {"root_kp", "root_kd"},
+       "the root's pitch and roll held by the stance hip, whose torque is the remainder (SIMBICON; Coros et al. 2010)"},
   };
   return kinds;
 }
@@ -282,7 +339,7 @@ int SkillFile::module_index(const std::string& n) const {
 SkillFile load_skill_file(const std::string& path) {
   const toml::table root = parse_toml_file(path, "skill");
   const TomlReader r = TomlReader(path, root, "").with_lines();
-  r.only({"name", "description", "root", "pairs", "events", "targets", "gains", "modules", "phases"});
+  r.only({"name", "description", "kind", "root", "pairs", "start", "events", "targets", "gains", "modules", "phases"});
   SkillFile s;
   s.file = path;
   s.name = r.string("name");
@@ -293,6 +350,13 @@ SkillFile load_skill_file(const std::string& path) {
   if (r.has("pairs")) s.pairs = r.strings("pairs");
   if (r.has("root")) s.root_line = line_of(*root.get("root"));
   if (r.has("pairs")) s.pairs_line = line_of(*root.get("pairs"));
+  const std::string motion = r.string("kind", "jump");
+  if (motion != "jump" && motion != "walk") r.fail("kind", "expected \"jump\" or \"walk\", got \"" + motion + "\"");
+  s.walk = motion == "walk";
+  const std::string start = r.string("start", "standing");
+  if (start != "standing" && start != "first_phase") r.fail("start", "expected \"standing\" or \"first_phase\", got \"" + start + "\"");
+  s.start_pose = start == "first_phase";
+  if (s.start_pose && s.root != RootKind::kFree) r.fail("start", "expected \"standing\": a start in the first phase's pose needs root = \"free\"");
 
   if (const toml::table* t = r.table("targets", true)) {
     const TomlReader tr = r.sub("targets", *t);
@@ -325,9 +389,18 @@ SkillFile load_skill_file(const std::string& path) {
       if (m.kind == k.kind) kind = &k;
     }
     if (kind == nullptr) mr.fail("kind", "expected one of " + quoted_list(kinds) + ", got \"" + m.kind + "\"");
+    for (const auto& [word, choices] : kind->words) {
+      if (!mr.has(word)) mr.fail(word, "expected a setting of the \"" + m.kind + "\" module (missing)");
+      const std::string value = mr.string(word);
+      if (std::none_of(choices.begin(), choices.end(), [&](const char* c) { return value == c; })) {
+        std::vector<std::string> list(choices.begin(), choices.end());
+        mr.fail(word, "expected one of " + quoted_list(list) + ", got \"" + value + "\"");
+      }
+      m.words[word] = value;
+    }
     for (const auto& [k, node] : *modules[i]) {
       const std::string key(k.str());
-      if (key == "name" || key == "kind") continue;
+      if (key == "name" || key == "kind" || m.words.count(key) > 0) continue;
       const bool known = std::any_of(kind->required.begin(), kind->required.end(), [&](const char* x) { return key == x; }) ||
                          std::any_of(kind->optional.begin(), kind->optional.end(), [&](const char* x) { return key == x; });
       if (!known) {
@@ -355,10 +428,17 @@ SkillFile load_skill_file(const std::string& path) {
   for (size_t i = 0; i < phases.size(); ++i) {
     readers.push_back(r.element("phases", i, *phases[i]));
     const TomlReader& pr = readers.back();
-    pr.only({"name", "targets", "gains", "duration", "interpolate", "modules", "next"});
+    pr.only({"name", "parameters", "swing", "targets", "gains", "duration", "interpolate", "modules", "next"});
     SkillPhase p;
     p.line = line_of(*phases[i]);
     p.name = pr.string("name");
+    p.parameters = pr.string("parameters", "");
+    if (pr.has("swing")) {
+      const std::string swing = pr.string("swing");
+      if (swing != "left" && swing != "right") pr.fail("swing", "expected \"left\" or \"right\", got \"" + swing + "\"");
+      if (s.root != RootKind::kFree) pr.fail("swing", "expected no swing leg: a phase with a swing leg needs root = \"free\"");
+      p.swing = swing == "left" ? 0 : 1;
+    }
     if (s.phase_index(p.name) >= 0) pr.fail("name", "expected a name no other phase has, got \"" + p.name + "\" twice");
     p.targets = pr.string("targets");
     if (s.target_sets.count(p.targets) == 0) pr.fail("targets", "expected a target set [targets." + p.targets + "] (none in the file)");
@@ -537,12 +617,28 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
     SkillPhaseBinding& pb = b.phases[p];
     pb.targets.assign(body.joints.size(), {});
     pb.gains.assign(body.joints.size(), {});
-    const std::string prefix = phase.name + ".";
+    const std::string prefix = (phase.parameters.empty() ? phase.name : phase.parameters) + ".";
+    pb.swing = phase.swing;
     // Which entry of the set drives each group: named ones first, then "other".
     const auto& set = skill.target_sets.at(phase.targets);
     std::vector<const SkillTarget*> entry(body.groups.size(), nullptr);
     const SkillTarget* other = nullptr;
+    // The root's pitch and roll first (heading frame, free roots).
     for (const SkillTarget& t : set) {
+      if (t.selector != "root") continue;
+      if (body.root != RootKind::kFree) fail(t.line, "targets." + phase.targets + ".root", "expected no root target: " + who + " has a planar root");
+      pb.root = true;
+      for (auto [v, jt, what] : {std::tuple{&t.pitch, &pb.root_pitch, "pitch"}, {&t.roll, &pb.root_roll, "roll"}}) {
+        jt->world = SkillTarget::World::kHeading;
+        jt->value = v;
+        jt->sign = v->mirror && phase.swing == 1 ? -1.0 : 1.0;
+        if (v->kind != SkillValue::Kind::kParam) continue;
+        ParamSpec spec{prefix + v->param, v->has_range ? v->lower : -M_PI, v->has_range ? v->upper : M_PI, v->unit.empty() ? "rad" : v->unit};
+        jt->param = add_param(b.params, spec, file, v->line, "targets." + phase.targets + ".root." + what);
+      }
+    }
+    for (const SkillTarget& t : set) {
+      if (t.selector == "root") continue;
       if (t.selector == "other") {
         other = &t;
         continue;
@@ -566,19 +662,36 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
         fail(phase.line, "phases." + phase.name + ".targets",
              "expected a target for the group \"" + group.name + "\" in [targets." + phase.targets + "] (or an \"other\" entry)");
       }
+      const std::string field = "targets." + phase.targets + "." + t->selector;
+      if (t->by_role && phase.swing < 0) {
+        fail(t->line, field, "expected a phase with a swing leg (swing = \"left\" or \"right\") for swing and stance targets, but phase \"" + phase.name + "\" has none");
+      }
+      if (t->by_role && group.joints.size() != 2) {
+        fail(t->line, field, "expected a left/right pair for swing and stance targets, but the group \"" + group.name + "\" of " + who + " has one joint");
+      }
       for (size_t side = 0; side < group.joints.size(); ++side) {
         const int j = group.joints[side];
         const SkillValue* v = &t->both;
-        if (t->sided) v = group.joints.size() == 2 && side == 1 ? &t->right : &t->left;
+        // Swing and stance: the swing leg's side holds the swing value.
+        const bool second = group.joints.size() == 2 && side == 1;
+        if (t->sided) v = (t->by_role ? (static_cast<int>(side) != phase.swing) : second) ? &t->right : &t->left;
         SkillJointTarget& jt = pb.targets[static_cast<size_t>(j)];
-        jt.world = t->world;
+        jt.world = v->world >= 0 ? static_cast<SkillTarget::World>(v->world) : t->world;
         jt.value = v;
+        jt.sign = v->mirror && phase.swing == 1 ? -1.0 : 1.0;
+        if (jt.world == SkillTarget::World::kHeading && body.root != RootKind::kFree) {
+          fail(v->line, field, "expected world = \"joint\", \"parent\" or \"child\": heading-frame targets need a free root, but " + who + " has a planar root");
+        }
         if (v->kind == SkillValue::Kind::kParam) {
           const CharacterJoint& joint = body.joints[static_cast<size_t>(group.joints[0])];
           ParamSpec spec{prefix + replace_group(v->param, group.name), v->lower, v->upper, v->unit.empty() ? "rad" : v->unit};
           if (!v->has_range) {
             spec.lower = std::isfinite(joint.lower) ? joint.lower : -M_PI;
             spec.upper = std::isfinite(joint.upper) ? joint.upper : M_PI;
+          } else if (jt.world == SkillTarget::World::kHeading) {
+            // Angles from standing: the range within what the joint allows from there.
+            if (std::isfinite(joint.lower)) spec.lower = std::max(joint.lower - joint.standing, spec.lower);
+            if (std::isfinite(joint.upper)) spec.upper = std::min(joint.upper - joint.standing, spec.upper);
           }
           jt.param = add_param(b.params, spec, file, v->line, "targets." + phase.targets + "." + t->selector);
         }
@@ -625,7 +738,8 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
   for (size_t p = 0; p < skill.phases.size(); ++p) {
     const SkillDuration& d = skill.phases[p].duration;
     if (d.kind != SkillDuration::Kind::kValue || d.value.kind != SkillValue::Kind::kParam) continue;
-    const ParamSpec spec{skill.phases[p].name + "." + d.value.param, d.value.lower, d.value.upper,
+    const SkillPhase& phase = skill.phases[p];
+    const ParamSpec spec{(phase.parameters.empty() ? phase.name : phase.parameters) + "." + d.value.param, d.value.lower, d.value.upper,
                          d.value.unit.empty() ? "s" : d.value.unit};
     b.phases[p].duration_param = add_param(b.params, spec, file, d.value.line, "phases." + skill.phases[p].name + ".duration");
   }
@@ -643,6 +757,17 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
   }
   for (size_t p = 0; p < skill.phases.size(); ++p) {
     for (const std::string& mod : skill.phases[p].modules) b.phases[p].modules.push_back(skill.module_index(mod));
+  }
+  // Feet by role need a swing leg.
+  for (const SkillPhase& phase : skill.phases) {
+    for (const SkillTransition& tr : phase.next) {
+      for (const SkillCondition& c : tr.on) {
+        if (c.kind == "contact_made" && c.foot == "swing") b.phases[static_cast<size_t>(skill.phase_index(phase.name))].swing_lands = true;
+        if ((c.foot == "swing" || c.foot == "stance") && phase.swing < 0) {
+          fail(tr.line, "phases." + phase.name + ".next.foot", "expected a phase with a swing leg (swing = \"left\" or \"right\") for foot = \"" + c.foot + "\"");
+        }
+      }
+    }
   }
   // Bodies the transitions name.
   if (m != nullptr) {

@@ -50,17 +50,25 @@ struct SkillValue {
   double lower = 0, upper = 0;
   std::string unit;
   std::vector<std::array<double, 2>> curve;  // knots (s, value), s increasing from 0 to 1
+  int world = -1;       // a side's own `world` (a SkillTarget::World), -1: the entry's
+  bool mirror = false;  // negated while the right leg swings (a centre link's roll)
   int line = 0;
 };
 
 // One entry of a target set. `selector`: a group name, a role ("hip"), the topmost group
-// of a role ("waist.top"), or "other" (every group no other entry names).
+// of a role ("waist.top"), "other" (every group no other entry names), or "root" (the free
+// root's pitch and roll in the heading frame, control/heading_frame.h).
 struct SkillTarget {
   std::string selector;
-  enum class World { kJoint, kParent, kChild };  // joint angle, or the world pitch of a link
+  // A joint angle; the world pitch of the link above or below the joint; or the link below
+  // the joint in the heading frame, all its hinges together (free roots; angles relative
+  // to standing).
+  enum class World { kJoint, kParent, kChild, kHeading };
   World world = World::kJoint;
-  bool sided = false;  // left and right given apart
+  bool sided = false;  // left and right given apart (or, with by_role, swing and stance)
+  bool by_role = false;  // left holds the swing leg's side, right the stance leg's
   SkillValue both, left, right;
+  SkillValue pitch, roll;  // "root"
   int line = 0;
 };
 
@@ -79,6 +87,7 @@ struct SkillCondition {
   double airborne = 0.01;  // liftoff: s without contact, the COM rising
   double angle = 0;        // turned: rad of root pitch since take-off
   std::string body;        // contact_made, contact_lost: an MJCF body of the character
+  std::string foot;        // contact_made, contact_lost: instead of a body, "swing", "stance", "left", "right"
   std::string feature;     // feature: com_x, com_z, com_vx, com_vz, pitch, pitch_rate
   bool above = true;       // feature: crosses above (true) or below `threshold`
   double threshold = 0;
@@ -103,6 +112,8 @@ struct SkillDuration {
 
 struct SkillPhase {
   std::string name;
+  std::string parameters;      // the prefix of its parameters' names ("" : the name)
+  int swing = -1;              // the leg that swings (0 left, 1 right), -1 none
   std::string targets, gains;  // set names; gains "" keeps the character's
   bool interpolate = true;     // false: targets at once
   SkillDuration duration;
@@ -114,6 +125,7 @@ struct SkillPhase {
 struct SkillModuleSpec {
   std::string name, kind;
   std::map<std::string, SkillValue> settings;  // numbers, booleans as 0/1, or parameters
+  std::map<std::string, std::string> words;    // settings that take a word (a plane)
   int line = 0;
 };
 
@@ -123,6 +135,8 @@ struct SkillFile {
   RootKind root = RootKind::kPlanar;
   std::vector<std::string> pairs;  // roles that must be left/right pairs
   int root_line = 1, pairs_line = 1;  // where they are written (1 when defaulted)
+  bool walk = false;        // kind = "walk": the task counts steps (task/walk_task.h), not a jump's events
+  bool start_pose = false;  // start = "first_phase": the rollout starts in the first phase's pose
   std::string push, takeoff, peak, landing;  // phase names; "" when none
   std::vector<std::string> film_strip;       // events shown
   std::map<std::string, std::vector<SkillTarget>> target_sets;
@@ -138,6 +152,8 @@ struct SkillModuleKind {
   const char* kind;
   std::vector<const char*> required, optional;
   const char* what;  // one line, for `diverse skill show` and messages
+  // Settings that take one of a few words: {setting, {word, ...}} (required).
+  std::vector<std::pair<const char*, std::vector<const char*>>> words = {};
 };
 const std::vector<SkillModuleKind>& skill_module_kinds();
 
@@ -155,6 +171,7 @@ struct SkillJointTarget {
   SkillTarget::World world = SkillTarget::World::kJoint;
   const SkillValue* value = nullptr;  // into the SkillFile
   int param = -1;                     // index into params when a parameter
+  double sign = 1;                    // -1: a mirrored value while the right leg swings
 };
 struct SkillJointGain {
   int kp_param = -1, kd_param = -1;   // parameters, or -1
@@ -165,6 +182,10 @@ struct SkillPhaseBinding {
   std::vector<SkillJointGain> gains;      // per Character::joints entry
   int duration_param = -1;
   std::vector<int> modules;               // indices into SkillFile::modules
+  int swing = -1;                         // the swinging leg (0 left, 1 right), -1 none
+  bool swing_lands = false;               // a transition on the swing foot's contact made
+  bool root = false;                      // root pitch and roll targets given
+  SkillJointTarget root_pitch, root_roll;  // world = kHeading
 };
 struct SkillBinding {
   std::vector<ParamSpec> params;

@@ -6,7 +6,8 @@
 // (before the transitions), then, on a transition, enter() for the modules of the phase
 // just begun; then set_targets() (after the engine's own targets), and last either
 // drive() for a module that takes the torques over (drives() true) or add_torques() into
-// the per-joint feedforward the PD torques add.
+// the per-joint feedforward the PD torques add, and then adjust_torques() on the torques
+// the engine is about to ask for (SkillState::u, damping), in the phase's module order.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -19,6 +20,7 @@
 
 #include "character/character.h"
 #include "control/controller.h"
+#include "control/heading_frame.h"
 #include "control/skill_file.h"
 #include "physics/drive.h"
 
@@ -44,6 +46,19 @@ struct SkillState {
   std::vector<double> goal;         // per joint: the phase's goal (rad; world pitch if tracked)
   std::vector<double> kp, kd;       // per joint: the phase's gains, before strength
   std::vector<double> feedforward;  // per joint: torque the PD adds (Nm), 0 each step
+  // Free roots (control/heading_frame.h).
+  int swing = -1;                     // the phase's swinging leg (0 left, 1 right), -1 none
+  // Both feet down in a phase with a swing leg: the swing foot still touches the ground
+  // (early in a step). A phase that ends when the swing foot comes down is never in double
+  // support: the touch-down ends it.
+  bool double_support = false;
+  double heading = 0;                 // rad, the root's heading this step
+  bool root = false;                  // the phase gives the root's pitch and roll
+  double root_pitch = 0, root_roll = 0;  // rad, in the heading frame (mirrored when given so)
+  const StandingFrames* standing = nullptr;  // the model's standing pose
+  // The torques about to be asked for: per joint u (Nm, all but the joint's own damping)
+  // and the damping gain kd (Nm s/rad), the drive applying u - kd qdot within the limit.
+  std::vector<double> u, damping;
 };
 
 class SkillModule {
@@ -72,6 +87,9 @@ class SkillModule {
     (void)m, (void)d, (void)s;
   }
   virtual void add_torques(const mjModel* m, const mjData* d, SkillState& s) {
+    (void)m, (void)d, (void)s;
+  }
+  virtual void adjust_torques(const mjModel* m, const mjData* d, SkillState& s) {
     (void)m, (void)d, (void)s;
   }
   virtual bool drives() const { return false; }

@@ -95,7 +95,7 @@ struct WalkControllerConfig : ControllerConfig {
 class WalkControllerType : public ControllerType {
  public:
   const char* name() const override { return "walk3d"; }
-  const char* skill() const override { return "walk"; }
+  const char* skill(const ControllerConfig&) const override { return "walk"; }
   const char* description() const override {
     return "SIMBICON walk of a character with a free root (per leg a timed state, then until touch-down)";
   }

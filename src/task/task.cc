@@ -296,7 +296,7 @@ Task load_task(const std::string& path) {
   if (auto t = r.table("seed", false)) read_seed(r.sub("seed", *t), task);
   if (auto t = r.table("diversity", false)) read_diversity(r.sub("diversity", *t), task);
   if (auto t = r.table("walk", false)) read_walk(r.sub("walk", *t), task.walk);
-  const bool walks = std::string(task.controller_type->skill()) == "walk";
+  const bool walks = std::string(task.controller_type->skill(*task.controller_config)) == "walk";
   if (walks != task.walk.enabled) {
     r.fail("walk", walks ? "expected a [walk] table for the walk controller \"" + task.controller + "\" (missing)"
                          : "expected no [walk] table: the controller \"" + task.controller + "\" does not walk");

@@ -479,7 +479,7 @@ TEST(BadInput, ReplayAgainstATaskOfAnotherSkill) {
   const std::string motion = (dir / "sim/motion.json").string();
   const Case cases[] = {
       {"replay " + motion + " --task silly_walk",
-       "motion.json: parameters: expected the parameters of controller 'walk3d' for character 'human3d'"},
+       "motion.json: parameters: expected the parameters of controller 'skill' for character 'human3d'"},
       {"replay " + motion + " --task robot_silly_walk", "motion.json: parameters: expected the parameters of controller"},
       {"replay " + motion + " --task jump_backwards",
        "motion.json: parameters: expected the parameters of controller 'jump3d' for character 'human3d'"},

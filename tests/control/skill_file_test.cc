@@ -79,8 +79,8 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
   };
   const std::vector<Bad> cases = {
       {"unknown_key", "pairs = ", "colour = \"red\"\npairs = ", "colour",
-       "colour: expected no such key (unknown key; known keys: name, description, root, pairs, events, targets, gains, "
-       "modules, phases)",
+       "colour: expected no such key (unknown key; known keys: name, description, kind, root, pairs, start, events, targets, "
+       "gains, modules, phases)",
        false},
       {"no_group", "neck = 0.0\n", "neck = 0.0\ntail = 0.0\n", "tail",
        "targets.stance.tail: expected a joint group, role or ROLE.top of the character " + human.body().spec->file +
@@ -102,7 +102,8 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
       {"missing_setting", "kp = 1500.0\n", "", "[[modules]]",
        "modules[0].kp: expected a setting of the \"balance\" module (missing)", false},
       {"unknown_kind", "kind = \"foot_placement\"", "kind = \"foot_planting\"", "foot_planting",
-       "modules[1].kind: expected one of \"balance\", \"foot_placement\", \"spotting\", \"stance\", got \"foot_planting\"",
+       "modules[1].kind: expected one of \"balance\", \"foot_placement\", \"spotting\", \"stance\", \"simbicon\", "
+       "\"gravity_compensation\", \"stance_support\", \"stance_hip\", got \"foot_planting\"",
        false},
       {"unknown_condition", "on = \"peak\"", "on = \"apex\"", "apex",
        "phases[3].next[1].on: expected one of \"duration\", \"time\", \"contact\", \"touchdown\", \"liftoff\", "
