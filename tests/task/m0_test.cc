@@ -86,7 +86,12 @@ const std::map<std::string, Neighbourhood> kNeighbourhood = {
     // one pushed off in joint space alone had 4 and the one before it none
     // (docs/notes/2026-12-07-joint-space-push-off.md, "Damping the body's turn in the push-off").
     {"jump_backwards", {0.02, 32, 16}},
-    {"robot_jump", {0.005, 32, 7}}};
+    {"robot_jump", {0.005, 32, 7}},
+    // The skills added as files: the hop measures 21 at 0.02, the split leap 22 at 0.02,
+    // the tailwalker's tuck jump 25 at 0.005 (docs/results.md, "Skills added as files").
+    {"hop", {0.02, 32, 16}},
+    {"split_leap", {0.02, 32, 16}},
+    {"tailwalker_tuck_jump", {0.005, 32, 18}}};
 
 TEST_P(M0, MeetsItsTask) {
   REQUIRE_M0(GetParam());
@@ -147,7 +152,9 @@ TEST_P(M0, SomeOfItsNeighbourhoodMeetsTheTask) {
 
 INSTANTIATE_TEST_SUITE_P(Tasks, M0,
                          ::testing::Values("backflip", "jump_forward", "jump_onto", "jump_over",
-                                           "jump_high", "jump_backwards", "robot_jump"));
+                                           "jump_high", "jump_backwards", "robot_jump",
+                                           // skills the paper does not have, added as files
+                                           "hop", "split_leap", "tailwalker_tuck_jump"));
 
 TEST(M0Specifics, BackflipTurnsOverOnce) {
   REQUIRE_M0("backflip");
@@ -402,6 +409,104 @@ TEST(M0Specifics, TheStrengthTwoExampleMeetsItsTask) {
 TEST(M0Specifics, JumpHighPeaksHighEnough) {
   REQUIRE_M0("jump_high");
   EXPECT_GE(simulate("jump_high").e.summary.peak_com_z, 1.20);
+}
+
+// The skills added as files alone (skills/hop.toml, split_leap.toml, tuck_jump.toml): each
+// committed input motion does what its skill is about, read from the recorded rollout.
+
+// The recorded qpos after the step that ends nearest `time` (s).
+const double* qpos_at(const SimRun& r, double time) {
+  const int step = std::clamp(static_cast<int>(std::lround(time / r.record.timestep)) - 1, 0, r.record.steps() - 1);
+  return r.record.qpos.data() + static_cast<size_t>(step) * static_cast<size_t>(r.record.nq);
+}
+
+double joint_angle(const mjModel* m, const double* qpos, const char* joint) {
+  const int id = mj_name2id(m, mjOBJ_JOINT, joint);
+  EXPECT_GE(id, 0) << joint;
+  return id >= 0 ? qpos[m->jnt_qposadr[id]] : 0;
+}
+
+// Which of two bodies (and the bodies below them) touch anything in the pose `qpos`.
+struct Touching {
+  bool a = false, b = false;
+};
+Touching touching(const mjModel* m, const double* qpos, const char* body_a, const char* body_b) {
+  mjData* d = mj_makeData(m);
+  std::copy(qpos, qpos + m->nq, d->qpos);
+  mj_forward(m, d);
+  const int a = mj_name2id(m, mjOBJ_BODY, body_a), b = mj_name2id(m, mjOBJ_BODY, body_b);
+  auto below = [m](int body, int top) {
+    for (; body > 0; body = m->body_parentid[body])
+      if (body == top) return true;
+    return false;
+  };
+  Touching t;
+  for (int i = 0; i < d->ncon; ++i) {
+    for (int geom : {d->contact[i].geom1, d->contact[i].geom2}) {
+      t.a = t.a || below(m->geom_bodyid[geom], a);
+      t.b = t.b || below(m->geom_bodyid[geom], b);
+    }
+  }
+  mj_deleteData(d);
+  return t;
+}
+
+// The hop pushes off the right foot alone and touches down on it alone: from 50 ms into
+// the push to take-off the left foot touches nothing while the right does, and at the first
+// touch-down only the right foot is down, the left still up.
+TEST(M0Specifics, HopPushesOffAndTouchesDownOnTheRightFoot) {
+  REQUIRE_M0("hop");
+  const SimRun r = simulate("hop");
+  const TaskEvaluator ev(load_task(kTasks + "hop.toml"));
+  const mjModel* m = ev.model().get();
+  const PhaseTimes& p = r.e.phases;
+  const double push = p.at(p.extend);
+  ASSERT_GT(push, 0);
+  ASSERT_GT(p.takeoff(), push + 0.05);
+  int right_down = 0, steps = 0;
+  for (double t = push + 0.05; t < p.takeoff(); t += r.record.timestep, ++steps) {
+    const Touching c = touching(m, qpos_at(r, t), "foot_l", "foot_r");
+    EXPECT_FALSE(c.a) << "the left foot touches at " << t << " s";
+    right_down += c.b;
+  }
+  // The right foot pushes until it leaves, 10 ms before the rise begins (the skill's
+  // lift-off transition waits 10 ms without contact).
+  EXPECT_GE(right_down, steps - static_cast<int>(std::ceil(0.01 / r.record.timestep)) - 1);
+  EXPECT_GT(right_down, 0);
+  const Touching down = touching(m, qpos_at(r, p.landing()), "foot_l", "foot_r");
+  EXPECT_TRUE(down.b);
+  EXPECT_FALSE(down.a);
+  // and the left hip and knee are folded while airborne (their targets' ranges)
+  const double* top = qpos_at(r, p.peak());
+  EXPECT_GT(joint_angle(m, top, "hip_l") - joint_angle(m, top, "hip_r"), 0.3);
+  EXPECT_LT(joint_angle(m, top, "knee_l"), -1.0);
+}
+
+// The split leap opens its legs front and back at the peak (the left thigh forward, the
+// right back, the knees nearly straight) and lands in the box 1 m ahead.
+TEST(M0Specifics, SplitLeapSplitsAtThePeak) {
+  REQUIRE_M0("split_leap");
+  const SimRun r = simulate("split_leap");
+  const TaskEvaluator ev(load_task(kTasks + "split_leap.toml"));
+  const mjModel* m = ev.model().get();
+  const double* top = qpos_at(r, r.e.phases.peak());
+  EXPECT_GT(joint_angle(m, top, "hip_l") - joint_angle(m, top, "hip_r"), 1.0);
+  EXPECT_GT(joint_angle(m, top, "hip_l"), 0.5);
+  EXPECT_LT(joint_angle(m, top, "hip_r"), 0.0);
+  EXPECT_NEAR(r.e.summary.touchdown_feet_x, 1.0, 0.15);
+}
+
+// The tailwalker's tuck jump has its hips and knees folded at the peak and its COM at
+// least 0.25 m above standing.
+TEST(M0Specifics, TailwalkerTuckJumpTucksAtThePeak) {
+  REQUIRE_M0("tailwalker_tuck_jump");
+  const SimRun r = simulate("tailwalker_tuck_jump");
+  const TaskEvaluator ev(load_task(kTasks + "tailwalker_tuck_jump.toml"));
+  const mjModel* m = ev.model().get();
+  const double* top = qpos_at(r, r.e.phases.peak());
+  for (const char* hip : {"coxa_left", "coxa_right"}) EXPECT_GT(joint_angle(m, top, hip), 1.0) << hip;
+  for (const char* knee : {"genu_left", "genu_right"}) EXPECT_LT(joint_angle(m, top, knee), -1.2) << knee;
+  EXPECT_GE(r.e.summary.peak_com_z - r.e.summary.standing_com_z, 0.25);
 }
 
 }  // namespace
