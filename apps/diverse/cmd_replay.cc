@@ -103,8 +103,10 @@ void check_task_of_motion(const std::string& path, const std::string& task_optio
   const TaskEvaluator ev(task);
   const std::string of_task = " (task " + task.file + ")";
   const std::string motion_task = motion.is_object() ? motion.value("task", std::string("?")) : std::string("?");
-  const std::string expected = "expected the parameters of controller '" + task.controller + "' for character '" +
-                               task.character_spec->name + "'" + of_task;
+  // A skill file's task is named by its skill, any other by its controller.
+  const std::string skill = task.controller_config->skill_name();
+  const std::string runs = skill.empty() ? "controller '" + task.controller + "'" : "skill '" + skill + "'";
+  const std::string expected = "expected the parameters of " + runs + " for character '" + task.character_spec->name + "'" + of_task;
   if (!motion.is_object() || !motion.contains("parameters") || !motion["parameters"].is_object())
     throw_field_error(path, "parameters", expected);
   const nlohmann::json& named = motion["parameters"];

@@ -92,6 +92,8 @@ class ControllerConfig {
   // where the COM comes down; continuation over box heights (task/seed_motion.h) sets it.
   virtual std::shared_ptr<const ControllerConfig> with_landing_height(double height) const = 0;
   virtual double landing_height() const = 0;
+  // The skill's name when the controller runs a skill file ("" otherwise), for messages.
+  virtual std::string skill_name() const { return ""; }
 };
 
 class ControllerType {
@@ -111,6 +113,12 @@ class ControllerType {
   // Checks the character can be driven by this controller (roles, root kind); throws
   // UserError "FILE: controller.type: expected ..." naming what is missing.
   virtual void check(const Character& body, const std::string& task_file) const = 0;
+  // The same with the task's configuration, for a controller whose fit to the character
+  // depends on it (a skill file's groups, bodies and root); by default the check above.
+  virtual void check(const Character& body, const ControllerConfig& config, const std::string& task_file) const {
+    (void)config;
+    check(body, task_file);
+  }
   // The free parameters for this character, named and ranged.
   virtual std::vector<ParamSpec> parameter_specs(const Character& body,
                                                  const ControllerConfig& config) const = 0;

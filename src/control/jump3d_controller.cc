@@ -123,33 +123,6 @@ double clamp_to_range(const CharacterJoint& j, double q) {
 
 }  // namespace
 
-HipAngles hip_angles_for(const Vec3& leg, const Vec3& pitch_axis, const Vec3& roll_axis, bool has_roll,
-                         const Vec3& direction) {
-  HipAngles out;
-  const Vec3& u = leg;
-  const Vec3& w = direction;
-  const Vec3& ap = pitch_axis;
-  // Roll first (the pitch, applied after it, keeps every component along its own axis):
-  // make u's component along the pitch axis equal w's. With a the roll axis (orthogonal to
-  // the pitch axis), (R(a, r) u) . ap = A cos r + B sin r, A = u . ap, B = (a x u) . ap.
-  if (has_roll) {
-    const Vec3& ar = roll_axis;
-    const double A = dot(u, ap), B = dot(cross(ar, u), ap), c = dot(w, ap);
-    const double R = std::hypot(A, B);
-    if (R > 1e-12) {
-      const double base = std::atan2(B, A), spread = std::acos(std::clamp(c / R, -1.0, 1.0));
-      const double r1 = std::remainder(base + spread, 2 * M_PI), r2 = std::remainder(base - spread, 2 * M_PI);
-      out.roll = std::fabs(r1) < std::fabs(r2) ? r1 : r2;
-    }
-  }
-  const Vec3 u1 = has_roll ? turn(roll_axis, out.roll, u) : u;
-  // Then the pitch: the turn about the pitch axis from u1 to w, in the plane normal to it.
-  const Vec3 a_perp = sub(u1, scale(ap, dot(u1, ap)));
-  const Vec3 b_perp = sub(w, scale(ap, dot(w, ap)));
-  out.pitch = std::atan2(dot(ap, cross(a_perp, b_perp)), dot(a_perp, b_perp));
-  return out;
-}
-
 std::shared_ptr<const ControllerConfig> Jump3dControllerConfig::with_landing_height(double height) const {
   auto c = std::make_shared<Jump3dControllerConfig>(*this);
   c->landing_height_m = height;

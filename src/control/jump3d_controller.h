@@ -113,25 +113,12 @@
 #include "character/character.h"
 #include "control/controller.h"
 #include "control/jump_controller.h"
+#include "control/module_aim_legs.h"
 #include "control/parameters.h"
 #include "control/stance_controller.h"
 #include "physics/com_velocity.h"
 
 namespace diverse {
-
-// The hip angles that point a leg in a given direction, for a hip of two orthogonal hinges
-// (pitch, then roll; `has_roll` false: pitch only). All vectors in one frame (the root's);
-// `leg` is the unit vector from the hip to the foot with both hip angles at their reference
-// (qpos0) values, `direction` the unit vector the leg should point along. Returns the
-// angles to add to the references, the roll nearest 0 of the two exact solutions; a
-// direction the hip cannot reach exactly (roll alone limits the component along the pitch
-// axis) gets the nearest one.
-struct HipAngles {
-  double pitch = 0, roll = 0;
-};
-HipAngles hip_angles_for(const std::array<double, 3>& leg, const std::array<double, 3>& pitch_axis,
-                         const std::array<double, 3>& roll_axis, bool has_roll,
-                         const std::array<double, 3>& direction);
 
 // Constants that are not optimized (documented defaults; the task file may override).
 struct Jump3dControllerConfig : ControllerConfig {

@@ -5,12 +5,15 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "control/module_aim_legs.h"
 #include "control/module_balance.h"
 #include "control/module_foot_placement.h"
 #include "control/module_gravity_compensation.h"
+#include "control/module_root_damping.h"
 #include "control/module_simbicon.h"
 #include "control/module_spotting.h"
 #include "control/module_stance.h"
+#include "control/module_stance3d.h"
 #include "control/module_stance_hip.h"
 #include "control/module_stance_support.h"
 #include "core/error.h"
@@ -89,7 +92,14 @@ const char* SkillControllerType::skill(const ControllerConfig& config) const {
 
 void SkillControllerType::check(const Character& body, const std::string& task_file) const {
   (void)body;
-  (void)task_file;  // bound (and checked) with the parameters, against the character's model
+  (void)task_file;  // the skill is checked with the task's configuration, below
+}
+
+void SkillControllerType::check(const Character& body, const ControllerConfig& config, const std::string& task_file) const {
+  (void)task_file;  // bind_skill's errors name the skill file's line
+  const auto* c = dynamic_cast<const SkillConfig*>(&config);
+  if (c == nullptr) throw std::logic_error("skill: configuration of another controller");
+  (void)c->binding(body);
 }
 
 std::vector<ParamSpec> SkillControllerType::parameter_specs(const Character& body, const ControllerConfig& config) const {
@@ -126,6 +136,8 @@ SkillController::SkillController(const Character& body, const SkillConfig& confi
   state_.kp.assign(n, 0.0);
   state_.kd.assign(n, 0.0);
   state_.feedforward.assign(n, 0.0);
+  state_.hold.assign(n, 0.0);
+  qpos0_.assign(n, 0.0);
   for (const SkillPhase& p : skill_->phases) times_.names.push_back(p.name);
   times_.begin.assign(skill_->phases.size(), -1.0);
   times_.extend = skill_->phase_index(skill_->push);
@@ -291,6 +303,7 @@ void SkillController::reset(const mjModel* m, const mjData* d) {
   gave_up_ = false;
   free_since_ = -1;
   takeoff_pitch_ = 0;
+  for (size_t i = 0; i < body_.joints.size(); ++i) qpos0_[i] = m->qpos0[body_.joints[i].qpos];
   for (auto& module : modules_) module->reset(m, d, state_);
   // Resolve named bodies once.
   bodies_.clear();
@@ -302,9 +315,12 @@ void SkillController::reset(const mjModel* m, const mjData* d) {
   state_.phase = 0;
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     state_.target[i] = d->qpos[body_.joints[i].qpos];
+    state_.hold[i] = state_.target[i];
     state_.from[i] = to_world(i, d->qpos, state_.target[i]);
   }
+  state_.from_pose = true;
   const SkillPhaseBinding& pb = binding_->phases[0];
+  state_.targets = &pb.targets;
   load_goals(pb);
   state_.phase_begin = d->time;
   state_.phase_duration = duration_of(0);
@@ -328,6 +344,12 @@ void SkillController::load_goals(const SkillPhaseBinding& pb) {
   for (size_t i = 0; i < body_.joints.size(); ++i) {
     const SkillJointTarget& t = pb.targets[i];
     state_.goal[i] = value(t);
+    if (t.value->kind == SkillValue::Kind::kStanding) state_.goal[i] = qpos0_[i];
+    if (t.from_standing) {
+      const CharacterJoint& j = body_.joints[i];
+      state_.goal[i] += qpos0_[i];
+      if (std::isfinite(j.lower) && std::isfinite(j.upper)) state_.goal[i] = std::clamp(state_.goal[i], j.lower, j.upper);
+    }
     const SkillJointGain& g = pb.gains[i];
     state_.kp[i] = g.kp_param >= 0 ? values_[static_cast<size_t>(g.kp_param)] : g.kp;
     state_.kd[i] = g.kd_param >= 0 ? values_[static_cast<size_t>(g.kd_param)] : g.kd;
@@ -341,11 +363,26 @@ void SkillController::enter(int phase, const mjModel* m, const mjData* d) {
   state_.phase_begin = t;
   state_.phase_changed = true;
   times_.begin[static_cast<size_t>(phase)] = t;
-  // The phase's targets start from those last commanded; world-frame ones from the pitch
-  // the last joint target implies for the tracked link in the current pose.
-  for (size_t i = 0; i < body_.joints.size(); ++i) state_.from[i] = to_world(i, q, state_.target[i]);
+  // The phase's targets start from those last commanded (world-frame ones from the pitch
+  // the last joint target implies for the tracked link in the current pose), from the
+  // previous phase's goals, from the pose now, or at its own goals.
+  const SkillPhase::From from = skill_->phases[static_cast<size_t>(phase)].from;
+  state_.from_pose = from == SkillPhase::From::kPose;
+  const size_t n = body_.joints.size();
+  if (from == SkillPhase::From::kGoals) {
+    state_.from = state_.goal;
+  } else if (from == SkillPhase::From::kPose) {
+    for (size_t i = 0; i < n; ++i) {
+      state_.hold[i] = q[body_.joints[i].qpos];
+      state_.from[i] = to_world(i, q, state_.hold[i]);
+    }
+  } else {
+    for (size_t i = 0; i < n; ++i) state_.from[i] = to_world(i, q, state_.target[i]);
+  }
   const SkillPhaseBinding& pb = binding_->phases[static_cast<size_t>(phase)];
+  state_.targets = &pb.targets;
   load_goals(pb);
+  if (from == SkillPhase::From::kNone) state_.from = state_.goal;
   if (phase == takeoff_) {
     state_.takeoff_com_z = state_.com[2];
     takeoff_pitch_ = q[body_.root_pitch_qpos];
@@ -458,7 +495,7 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
     for (int k : pb.modules) skip = skip || modules_[static_cast<size_t>(k)]->owns_target(static_cast<int>(i));
     if (skip) continue;
     const SkillJointTarget& jt = pb.targets[i];
-    const bool tracked = jt.world != SkillTarget::World::kJoint;
+    const bool tracked = jt.world == SkillTarget::World::kParent || jt.world == SkillTarget::World::kChild;
     if (jt.value->kind == SkillValue::Kind::kCurve) {
       const auto& knots = jt.value->curve;
       size_t k = 1;
@@ -499,7 +536,7 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
     // The strength model scales every joint's PD gains (Character::strength).
     const double kp = body_.strength * state_.kp[i];
     const double kd = body_.strength * state_.kd[i];
-    const SkillTarget::World w = pb.targets[i].world;
+    SkillTarget::World w = pb.targets[i].world;
     preset_[i] = 0;
     if (w == SkillTarget::World::kHeading) {
       // The link below the joint tracks its heading-frame orientation: the rotation error e
@@ -519,6 +556,8 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
       state_.damping[i] = kd;
       continue;
     }
+    // A stance3d module's world pitches are PD joint targets here (their joints hold).
+    if (w != SkillTarget::World::kParent && w != SkillTarget::World::kChild) w = SkillTarget::World::kJoint;
     if (w != SkillTarget::World::kJoint && drive.damping() == Damping::kConstrained) {
       // The drive damps the tracked link's world pitch rate itself: root pitch rate plus
       // the joint rates down the chain to the child; the parent's is that less qdot.
@@ -579,6 +618,9 @@ std::unique_ptr<SkillModule> make_skill_module(const SkillModuleSpec& spec, cons
   if (spec.kind == "gravity_compensation") return std::make_unique<GravityCompensationModule>(body);
   if (spec.kind == "stance_support") return std::make_unique<StanceSupportModule>(settings, body);
   if (spec.kind == "stance_hip") return std::make_unique<StanceHipModule>(settings, body);
+  if (spec.kind == "stance3d") return std::make_unique<Stance3dModule>(settings, body);
+  if (spec.kind == "aim_legs") return std::make_unique<AimLegsModule>(settings, body);
+  if (spec.kind == "root_damping") return std::make_unique<RootDampingModule>(settings, body);
   throw std::logic_error("skill: no module of kind " + spec.kind);
 }
 

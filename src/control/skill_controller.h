@@ -55,6 +55,7 @@ struct SkillConfig : ControllerConfig {
   double landing_height_m = 0;  // m
   std::shared_ptr<const ControllerConfig> with_landing_height(double height) const override;
   double landing_height() const override { return landing_height_m; }
+  std::string skill_name() const override { return skill->name; }
   // The skill bound to a character's structure, made once per character file.
   std::shared_ptr<const SkillBinding> binding(const Character& body) const;
 
@@ -70,6 +71,9 @@ class SkillControllerType : public ControllerType {
   const char* skill(const ControllerConfig& config) const override;
   std::shared_ptr<const ControllerConfig> read_config(const TomlReader& r) const override;
   void check(const Character& body, const std::string& task_file) const override;
+  // Binds the skill to the character (bind_skill): a group, role or body it does not
+  // have, or another root, is the skill file's error line.
+  void check(const Character& body, const ControllerConfig& config, const std::string& task_file) const override;
   std::vector<ParamSpec> parameter_specs(const Character& body, const ControllerConfig& config) const override;
   std::unique_ptr<Controller> make(const Character& body, const ControllerConfig& config,
                                    const std::vector<double>& values) const override;
@@ -123,6 +127,7 @@ class SkillController : public Controller {
   double free_since_ = -1;    // liftoff: time contact was last lost, -1 if touching
   double takeoff_pitch_ = 0;  // root pitch at take-off (rad)
   std::vector<std::pair<const SkillCondition*, int>> bodies_;  // conditions' bodies: MuJoCo ids
+  std::vector<double> qpos0_;      // per joint: its angle in the standing pose
   std::vector<DampedDof> damped_;  // scratch: a tracked joint's damped velocity
   SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
   // Free roots: whether any phase tracks the root or a link in the heading frame, the

@@ -28,7 +28,7 @@ bool as_number(const toml::node& n, double* v) {
 }
 
 constexpr const char* kValueForms =
-    "expected a number, { param = \"NAME\", range = [LOWER, UPPER] } or { curve = [[s, value], ...] }";
+    "expected a number, \"standing\", { param = \"NAME\", range = [LOWER, UPPER] } or { curve = [[s, value], ...] }";
 
 // `range = [lower, upper]`, lower < upper.
 void read_range(const TomlReader& r, SkillValue& v) {
@@ -52,10 +52,14 @@ SkillValue read_value(const TomlReader& parent, const std::string& key, const to
   SkillValue v;
   v.line = line_of(n);
   if (as_number(n, &v.number)) return v;
+  if (const auto str = n.as_string(); str != nullptr && str->get() == "standing") {
+    v.kind = SkillValue::Kind::kStanding;
+    return v;
+  }
   const toml::table* t = n.as_table();
   if (t == nullptr) parent.fail(key, kValueForms);
   const TomlReader r = parent.sub(key.c_str(), *t);
-  std::vector<const char*> known = {"param", "value", "curve", "range", "unit"};
+  std::vector<const char*> known = {"param", "value", "curve", "range", "unit", "sides"};
   known.insert(known.end(), extra.begin(), extra.end());
   for (const auto& [k, node] : *t) {
     // A named copy: clang before 16 does not let a lambda capture a structured binding.
@@ -78,6 +82,9 @@ SkillValue read_value(const TomlReader& parent, const std::string& key, const to
     if (v.param.empty()) r.fail("param", "expected a parameter name");
     read_range(r, v);
     v.unit = r.string("unit", "");
+    v.sides = r.boolean("sides", false);
+  } else if (r.has("sides")) {
+    r.fail("sides", "expected it only with a parameter (param = \"NAME\")");
   } else if (r.has("value")) {
     if (!as_number(*t->get("value"), &v.number)) r.fail("value", "expected a number");
   } else {
@@ -105,7 +112,12 @@ SkillTarget::World read_world(const TomlReader& r) {
   if (world == "parent") return SkillTarget::World::kParent;
   if (world == "child") return SkillTarget::World::kChild;
   if (world == "heading") return SkillTarget::World::kHeading;
-  if (world != "joint") r.fail("world", "expected \"joint\", \"parent\", \"child\" or \"heading\", got \"" + world + "\"");
+  if (world == "root") return SkillTarget::World::kRoot;
+  if (world == "torso") return SkillTarget::World::kTorso;
+  if (world == "sole") return SkillTarget::World::kSole;
+  if (world != "joint") {
+    r.fail("world", "expected \"joint\", \"parent\", \"child\", \"heading\", \"root\", \"torso\" or \"sole\", got \"" + world + "\"");
+  }
   return SkillTarget::World::kJoint;
 }
 
@@ -141,10 +153,14 @@ void read_target_set(const TomlReader& sets, const std::string& name, const toml
       out.push_back(target);
       continue;
     }
-    target.both = read_value(r, target.selector, node, {"world", "left", "right", "swing", "stance", "mirror"});
+    target.both = read_value(r, target.selector, node, {"world", "left", "right", "swing", "stance", "mirror", "relative"});
     if (const toml::table* e = node.as_table()) {
       const TomlReader er = r.sub(target.selector.c_str(), *e);
       target.world = read_world(er);
+      const std::string relative = er.string("relative", "zero");
+      if (relative != "zero" && relative != "standing") er.fail("relative", "expected \"standing\" (an offset from the standing pose), got \"" + relative + "\"");
+      target.from_standing = relative == "standing";
+      if (target.from_standing && target.world != SkillTarget::World::kJoint) er.fail("relative", "expected it only with joint targets (world = \"joint\")");
       const bool lr = er.has("left") || er.has("right"), roles = er.has("swing") || er.has("stance");
       if (lr || roles) {
         const char* a = lr ? "left" : "swing";
@@ -179,7 +195,7 @@ void read_gain_set(const TomlReader& sets, const std::string& name, const toml::
     g.kp = read_value(er, "kp", *e->get("kp"));
     g.kd = read_value(er, "kd", *e->get("kd"));
     for (const SkillValue* v : {&g.kp, &g.kd}) {
-      if (v->kind == SkillValue::Kind::kCurve) er.fail(v == &g.kp ? "kp" : "kd", "expected a number or a parameter (gains take no curve)");
+      if (v->kind == SkillValue::Kind::kCurve || v->kind == SkillValue::Kind::kStanding) er.fail(v == &g.kp ? "kp" : "kd", "expected a number or a parameter (gains take no curve)");
       if (v->kind == SkillValue::Kind::kParam && !v->has_range) er.fail(v == &g.kp ? "kp" : "kd", "expected a range = [LOWER, UPPER] for a gain parameter");
     }
     out.push_back(g);
@@ -281,7 +297,7 @@ SkillDuration read_duration(const TomlReader& r, const toml::table& phase) {
   }
   d.kind = SkillDuration::Kind::kValue;
   d.value = read_value(r, "duration", *n);
-  if (d.value.kind == SkillValue::Kind::kCurve) r.fail("duration", "expected a number or a parameter (a duration takes no curve)");
+  if (d.value.kind == SkillValue::Kind::kCurve || d.value.kind == SkillValue::Kind::kStanding) r.fail("duration", "expected a number or a parameter (a duration takes no curve)");
   if (d.value.kind == SkillValue::Kind::kParam && !d.value.has_range) r.fail("duration", "expected a range = [LOWER, UPPER] for a duration parameter");
   if (d.value.kind == SkillValue::Kind::kNumber && !(d.value.number > 0)) r.fail("duration", "expected a duration > 0 s, got " + num(d.value.number));
   return d;
@@ -292,9 +308,9 @@ SkillDuration read_duration(const TomlReader& r, const toml::table& phase) {
 // finite value.
 void check_setting(const TomlReader& r, const std::string& key, double v) {
   double lo = 0, hi = 1e9;
-  if (key == "offset" || key == "velocity_gain") lo = -1e9;
+  if (key.rfind("offset", 0) == 0 || key.rfind("velocity_gain", 0) == 0 || key == "speed") lo = -1e9;
   if (key == "stand_after") lo = -1;
-  if (key == "at_touchdown") hi = 1;
+  if (key == "at_touchdown" || key == "push" || key == "take_footing") hi = 1;
   if (key == "turn") hi = 8 * M_PI;
   if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + num(lo) + ", " + num(hi) + "], got " + num(v));
 }
@@ -320,6 +336,12 @@ const std::vector<SkillModuleKind>& skill_module_kinds() {
        "the stance leg's knee and the joints below it carry `support` times the weight, J^T of an upward force on the COM"},
       {"stance_hip", {}, {"root_kp", "root_kd"},
        "the root's pitch and roll held by the stance hip, whose torque is the remainder (SIMBICON; Coros et al. 2010)"},
+      {"stance3d", {}, {"offset", "speed", "push", "take_footing", "com_kp", "com_kd", "yaw_kp", "yaw_kd"},
+       "stance control of a free root: J^T COM force, the root, torso and soles at their world pitches"},
+      {"aim_legs", {"offset_left", "offset_right", "velocity_gain_left", "velocity_gain_right"}, {},
+       "landing of a free root: the hips point each leg where the COM comes down (paper section 6)"},
+      {"root_damping", {"kd"}, {},
+       "push-off turn damping: the hip hinges damp the root's rotation about their axes"},
   };
   return kinds;
 }
@@ -410,7 +432,7 @@ SkillFile load_skill_file(const std::string& path) {
         mr.fail(key, "expected no such setting for a \"" + m.kind + "\" module (known: " + list + ")");
       }
       SkillValue v = read_value(mr, key, node);
-      if (v.kind == SkillValue::Kind::kCurve) mr.fail(key, "expected a number or a parameter (a setting takes no curve)");
+      if (v.kind == SkillValue::Kind::kCurve || v.kind == SkillValue::Kind::kStanding) mr.fail(key, "expected a number or a parameter (a setting takes no curve)");
       if (v.kind == SkillValue::Kind::kParam && !v.has_range) mr.fail(key, "expected a range = [LOWER, UPPER] for a module parameter");
       if (v.kind == SkillValue::Kind::kNumber) check_setting(mr, key, v.number);
       m.settings[key] = v;
@@ -428,7 +450,7 @@ SkillFile load_skill_file(const std::string& path) {
   for (size_t i = 0; i < phases.size(); ++i) {
     readers.push_back(r.element("phases", i, *phases[i]));
     const TomlReader& pr = readers.back();
-    pr.only({"name", "parameters", "swing", "targets", "gains", "duration", "interpolate", "modules", "next"});
+    pr.only({"name", "parameters", "swing", "targets", "gains", "duration", "interpolate", "from", "modules", "next"});
     SkillPhase p;
     p.line = line_of(*phases[i]);
     p.name = pr.string("name");
@@ -445,6 +467,11 @@ SkillFile load_skill_file(const std::string& path) {
     p.gains = pr.string("gains", "");
     if (!p.gains.empty() && s.gain_sets.count(p.gains) == 0) pr.fail("gains", "expected a gain set [gains." + p.gains + "] (none in the file)");
     p.interpolate = pr.boolean("interpolate", true);
+    const std::string from = pr.string("from", "targets");
+    if (from == "goals") p.from = SkillPhase::From::kGoals;
+    else if (from == "pose") p.from = SkillPhase::From::kPose;
+    else if (from == "none") p.from = SkillPhase::From::kNone;
+    else if (from != "targets") pr.fail("from", "expected \"targets\", \"goals\", \"pose\" or \"none\", got \"" + from + "\"");
     p.duration = read_duration(pr, *phases[i]);
     if (pr.has("modules")) p.modules = pr.strings("modules");
     for (const std::string& m : p.modules) {
@@ -546,11 +573,20 @@ std::vector<int> select_groups(const std::string& selector, const Character& bod
   const int named = body.find_group(selector);
   if (named >= 0) out.push_back(named);
   std::string role = selector;
-  const bool top = selector.size() > 4 && selector.compare(selector.size() - 4, 4, ".top") == 0;
+  auto ends_with = [&](const std::string& tail) {
+    return selector.size() > tail.size() && selector.compare(selector.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  const bool top = ends_with(".top");
+  // ROLE.sagittal, ROLE.coronal: the role's groups in that plane.
+  const bool sagittal = ends_with(".sagittal"), coronal = ends_with(".coronal");
   if (top) role = selector.substr(0, selector.size() - 4);
+  if (sagittal) role = selector.substr(0, selector.size() - 9);
+  if (coronal) role = selector.substr(0, selector.size() - 8);
   size_t depth = 0;
   for (size_t g = 0; g < body.groups.size(); ++g) {
     if (role != to_string(body.groups[g].role)) continue;
+    if (sagittal && body.groups[g].plane != JointPlane::kSagittal) continue;
+    if (coronal && body.groups[g].plane != JointPlane::kCoronal) continue;
     if (!top) {
       if (static_cast<int>(g) != named) out.push_back(static_cast<int>(g));
       continue;
@@ -581,6 +617,12 @@ int add_param(std::vector<ParamSpec>& params, const ParamSpec& spec, const std::
   }
   params.push_back(spec);
   return static_cast<int>(params.size() - 1);
+}
+
+// `sides`: a parameter of a left/right pair is two, NAME_left and NAME_right.
+std::string side_name(const SkillValue& v, const JointGroup& group, size_t side) {
+  if (!v.sides || group.joints.size() != 2) return "";
+  return side == 0 ? "_left" : "_right";
 }
 
 std::string replace_group(std::string name, const std::string& group) {
@@ -678,13 +720,18 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
         SkillJointTarget& jt = pb.targets[static_cast<size_t>(j)];
         jt.world = v->world >= 0 ? static_cast<SkillTarget::World>(v->world) : t->world;
         jt.value = v;
+        jt.from_standing = t->from_standing;
         jt.sign = v->mirror && phase.swing == 1 ? -1.0 : 1.0;
         if (jt.world == SkillTarget::World::kHeading && body.root != RootKind::kFree) {
           fail(v->line, field, "expected world = \"joint\", \"parent\" or \"child\": heading-frame targets need a free root, but " + who + " has a planar root");
         }
+        if ((jt.world == SkillTarget::World::kRoot || jt.world == SkillTarget::World::kTorso ||
+             jt.world == SkillTarget::World::kSole) && body.root != RootKind::kFree) {
+          fail(v->line, field, "expected world = \"joint\", \"parent\" or \"child\": the world pitches a stance3d module holds need a free root, but " + who + " has a planar root");
+        }
         if (v->kind == SkillValue::Kind::kParam) {
           const CharacterJoint& joint = body.joints[static_cast<size_t>(group.joints[0])];
-          ParamSpec spec{prefix + replace_group(v->param, group.name), v->lower, v->upper, v->unit.empty() ? "rad" : v->unit};
+          ParamSpec spec{prefix + replace_group(v->param, group.name) + side_name(*v, group, side), v->lower, v->upper, v->unit.empty() ? "rad" : v->unit};
           if (!v->has_range) {
             spec.lower = std::isfinite(joint.lower) ? joint.lower : -M_PI;
             spec.upper = std::isfinite(joint.upper) ? joint.upper : M_PI;
@@ -717,19 +764,22 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
       for (size_t g = 0; g < body.groups.size(); ++g) {
         const SkillGain* e = gentry[g];
         if (e == nullptr) continue;
-        int kp = -1, kd = -1;
-        for (auto [value, index] : {std::pair{&e->kp, &kp}, {&e->kd, &kd}}) {
-          if (value->kind != SkillValue::Kind::kParam) continue;
-          const ParamSpec spec{prefix + replace_group(value->param, body.groups[g].name), value->lower, value->upper,
-                               value->unit.empty() ? (value == &e->kp ? "Nm/rad" : "Nm s/rad") : value->unit};
-          *index = add_param(b.params, spec, file, value->line, "gains." + phase.gains + "." + e->selector);
-        }
-        for (int j : body.groups[g].joints) {
-          SkillJointGain& jg = b.phases[p].gains[static_cast<size_t>(j)];
-          jg.kp_param = kp;
-          jg.kd_param = kd;
-          if (kp < 0) jg.kp = e->kp.number;
-          if (kd < 0) jg.kd = e->kd.number;
+        // kp, then kd; a sided parameter the left joint's, then the right's.
+        const JointGroup& group = body.groups[g];
+        for (const SkillValue* value : {&e->kp, &e->kd}) {
+          for (size_t side = 0; side < group.joints.size(); ++side) {
+            SkillJointGain& jg = b.phases[p].gains[static_cast<size_t>(group.joints[side])];
+            int& index = value == &e->kp ? jg.kp_param : jg.kd_param;
+            double& number = value == &e->kp ? jg.kp : jg.kd;
+            index = -1;
+            if (value->kind != SkillValue::Kind::kParam) {
+              number = value->number;
+              continue;
+            }
+            const ParamSpec spec{prefix + replace_group(value->param, group.name) + side_name(*value, group, side), value->lower,
+                                 value->upper, value->unit.empty() ? (value == &e->kp ? "Nm/rad" : "Nm s/rad") : value->unit};
+            index = add_param(b.params, spec, file, value->line, "gains." + phase.gains + "." + e->selector);
+          }
         }
       }
     }

@@ -42,13 +42,15 @@ namespace diverse {
 // A number, a named parameter (with its range) or a piecewise-linear curve over the
 // phase's normalized time s in [0, 1].
 struct SkillValue {
-  enum class Kind { kNumber, kParam, kCurve };
+  // kStanding: the joint's angle in the model's standing pose (qpos0), written "standing".
+  enum class Kind { kNumber, kParam, kCurve, kStanding };
   Kind kind = Kind::kNumber;
   double number = 0;
   std::string param;           // as written: may hold "{group}"; phases prefix "PHASE."
   bool has_range = false;      // a parameter without a range takes its joint's
   double lower = 0, upper = 0;
   std::string unit;
+  bool sides = false;          // a parameter: NAME_left and NAME_right for a left/right pair
   std::vector<std::array<double, 2>> curve;  // knots (s, value), s increasing from 0 to 1
   int world = -1;       // a side's own `world` (a SkillTarget::World), -1: the entry's
   bool mirror = false;  // negated while the right leg swings (a centre link's roll)
@@ -56,15 +58,19 @@ struct SkillValue {
 };
 
 // One entry of a target set. `selector`: a group name, a role ("hip"), the topmost group
-// of a role ("waist.top"), "other" (every group no other entry names), or "root" (the free
-// root's pitch and roll in the heading frame, control/heading_frame.h).
+// of a role ("waist.top"), the groups of a role in a plane ("hip.sagittal"), "other" (every
+// group no other entry names), or "root" (the free root's pitch and roll in the heading
+// frame, control/heading_frame.h).
 struct SkillTarget {
   std::string selector;
-  // A joint angle; the world pitch of the link above or below the joint; or the link below
-  // the joint in the heading frame, all its hinges together (free roots; angles relative
-  // to standing).
-  enum class World { kJoint, kParent, kChild, kHeading };
+  // A joint angle; the world pitch of the link above or below the joint (planar
+  // characters); the link below the joint in the heading frame, all its hinges together
+  // (free roots; angles relative to standing); or, for a free root, a world pitch a
+  // "stance3d" module holds through the stance legs: the root's (kRoot), the torso's
+  // (kTorso), each sole's (kSole).
+  enum class World { kJoint, kParent, kChild, kHeading, kRoot, kTorso, kSole };
   World world = World::kJoint;
+  bool from_standing = false;  // relative = "standing": added to qpos0, kept in the joint's range
   bool sided = false;  // left and right given apart (or, with by_role, swing and stance)
   bool by_role = false;  // left holds the swing leg's side, right the stance leg's
   SkillValue both, left, right;
@@ -116,6 +122,10 @@ struct SkillPhase {
   int swing = -1;              // the leg that swings (0 left, 1 right), -1 none
   std::string targets, gains;  // set names; gains "" keeps the character's
   bool interpolate = true;     // false: targets at once
+  // Where its targets start: those last commanded (kTargets), the previous phase's goals
+  // (kGoals), the pose it begins in (kPose), or its own goals (kGoals of this phase: kNone).
+  enum class From { kTargets, kGoals, kPose, kNone };
+  From from = From::kTargets;
   SkillDuration duration;
   std::vector<std::string> modules;
   std::vector<SkillTransition> next;
@@ -172,6 +182,7 @@ struct SkillJointTarget {
   const SkillValue* value = nullptr;  // into the SkillFile
   int param = -1;                     // index into params when a parameter
   double sign = 1;                    // -1: a mirrored value while the right leg swings
+  bool from_standing = false;         // the value added to qpos0, within the joint's range
 };
 struct SkillJointGain {
   int kp_param = -1, kd_param = -1;   // parameters, or -1

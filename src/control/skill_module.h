@@ -45,6 +45,9 @@ struct SkillState {
   std::vector<double> from;         // per joint: where the phase's targets start
   std::vector<double> goal;         // per joint: the phase's goal (rad; world pitch if tracked)
   std::vector<double> kp, kd;       // per joint: the phase's gains, before strength
+  std::vector<double> hold;         // per joint: its angle when the last phase from the pose began
+  bool from_pose = false;           // the current phase began from the pose (from = "pose")
+  const std::vector<SkillJointTarget>* targets = nullptr;  // the current phase's, per joint
   std::vector<double> feedforward;  // per joint: torque the PD adds (Nm), 0 each step
   // Free roots (control/heading_frame.h).
   int swing = -1;                     // the phase's swinging leg (0 left, 1 right), -1 none

@@ -359,7 +359,7 @@ TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
   body_->strength = task_.strength;
   if (task_.strength != 1.0) check_strength();
   check_scene(task_, model_->get(), *body_);
-  task_.controller_type->check(*body_, task_.file);
+  task_.controller_type->check(*body_, *task_.controller_config, task_.file);
   specs_ = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
   if (task_.constraints.clearance) {
     obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());

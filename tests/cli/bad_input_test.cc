@@ -222,11 +222,9 @@ TEST(BadInput, TaskFileFields) {
       task_case(task_text("jump_high", {{"skill = \"", "type = \"jump9d\"\nskill = \""}}), "controller.type"),
       task_case(task_text("jump_high", {{"skill = \"", "balance = { kp = -1.0 }\nskill = \""}}),
                 "controller.balance.kp: expected"),
-      // jump3d's asymmetric option takes true or false only.
-      task_case(task_text("jump_backwards", {{"asymmetric = true", "asymmetric = \"yes\""}}),
-                "controller.asymmetric: expected true or false"),
-      task_case(task_text("jump_backwards", {{"asymmetric = true", "asymmetric = 1"}}),
-                "controller.asymmetric: expected true or false"),
+      // The old controller's toggles are no keys of a skill's task: the skill file says it.
+      task_case(task_text("jump_backwards", {{"skill = \"", "asymmetric = true\nskill = \""}}),
+                "controller.asymmetric: expected no such key (unknown key; known keys: type, skill, landing_height, crouch, push, land, landing"),
       task_case(task_text("jump_high", {{"character = \"" + kSource + "/assets/characters/human2d.toml\"",
                                          "character = \"" + dir.string() + "\""}}),
                 "character: expected an existing file (relative to the task file)"),
@@ -481,9 +479,10 @@ TEST(BadInput, ReplayAgainstATaskOfAnotherSkill) {
       {"replay " + motion + " --task silly_walk",
        "motion.json: parameters: expected the parameters of controller 'skill' for character 'human3d'"},
       {"replay " + motion + " --task robot_silly_walk", "motion.json: parameters: expected the parameters of controller"},
+      // A task that names a skill file is named by its skill.
       {"replay " + motion + " --task jump_backwards",
-       "motion.json: parameters: expected the parameters of controller 'jump3d' for character 'human3d'"},
-      {"replay " + motion + " --task robot_jump", "motion.json: parameters: expected the parameters of controller 'jump3d'"},
+       "motion.json: parameters: expected the parameters of skill 'jump3d' for character 'human3d'"},
+      {"replay " + motion + " --task robot_jump", "motion.json: parameters: expected the parameters of skill 'robot_jump'"},
       {"replay " + motion + " --task " + kSource + "/examples/own-character/leap.toml", "motion.json: "},
       // The same controller and character with the paper's foot targets: 90 parameters,
       // where the high jump's level feet leave 87.

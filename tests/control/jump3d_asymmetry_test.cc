@@ -25,6 +25,7 @@
 #include "core/error.h"
 #include "physics/rollout.h"
 #include "task/evaluate.h"
+#include "support/jump3d_variant.h"
 
 namespace diverse {
 namespace {
@@ -45,13 +46,10 @@ std::string read(const std::string& path) {
 // here were found (a task file that asks for `damping = "constrained"`,
 // `joint_space_extend = true` or `extend_root_kd` has that line dropped).
 std::string task_variant(const std::string& name, const std::string& line) {
-  std::string t = read(kRoot + "/tasks/" + name + ".toml");
+  std::string t = read(test_files::jump3d_variant(name).string());
   t = std::regex_replace(t, std::regex("\ndamping = \"constrained\""), "\n");
   t = std::regex_replace(t, std::regex("\njoint_space_extend = true"), "\n");
   t = std::regex_replace(t, std::regex("\nextend_root_kd = [0-9.]+"), "\n");
-  t = std::regex_replace(t, std::regex("\"\\.\\./assets/"), "\"" + kRoot + "/assets/");
-  t = std::regex_replace(t, std::regex("m0 = \""), "m0 = \"" + kRoot + "/tasks/");
-  t = std::regex_replace(t, std::regex("base = \""), "base = \"" + kRoot + "/tasks/");
   const std::string on = "asymmetric = true";
   const auto at = t.find(on);
   EXPECT_NE(at, std::string::npos) << name << ".toml does not turn the option on";

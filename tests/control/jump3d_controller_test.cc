@@ -18,6 +18,7 @@
 #include "physics/drive.h"
 #include "physics/model.h"
 #include "task/evaluate.h"
+#include "support/jump3d_variant.h"
 
 namespace diverse {
 namespace {
@@ -39,7 +40,7 @@ std::set<std::string> names_of(const std::vector<ParamSpec>& specs) {
 // by what they are), and kp, kd of hips, knees and ankles; then nine more. (Left and right
 // sharing their parameters; tests/control/jump3d_asymmetry_test.cc splits them.)
 TEST(Jump3dParameters, NamedAndRangedForTheHuman) {
-  const TaskEvaluator ev(load_task(kRoot + "/tasks/jump_backwards.toml"));
+  const TaskEvaluator ev(load_task(test_files::jump3d_variant("jump_backwards").string()));
   const auto specs = Jump3dController::parameter_specs(ev.body());
   EXPECT_EQ(specs.size(), 6u * (6 + 6) + 9);
   const auto names = names_of(specs);
@@ -63,7 +64,7 @@ TEST(Jump3dParameters, NamedAndRangedForTheHuman) {
 }
 
 TEST(Jump3dParameters, NamedAndRangedForTheRobot) {
-  const TaskEvaluator ev(load_task(kRoot + "/tasks/robot_jump.toml"));
+  const TaskEvaluator ev(load_task(test_files::jump3d_variant("robot_jump").string()));
   const auto specs = Jump3dController::parameter_specs(ev.body());
   EXPECT_EQ(specs.size(), 6u * (4 + 6) + 9);
   const auto names = names_of(specs);
@@ -115,7 +116,7 @@ TEST(Jump3dController, ReadsItsOwnKeysStrictly) {
 // exactly along the asked direction, for both characters and both legs, whatever the knee.
 TEST(Jump3dController, HipAnglesPointTheLegWhereAsked) {
   for (const char* task : {"jump_backwards", "robot_jump"}) {
-    const TaskEvaluator ev(load_task(kRoot + "/tasks/" + task + ".toml"));
+    const TaskEvaluator ev(load_task(test_files::jump3d_variant(task).string()));
     const mjModel* m = ev.model().get();
     const Character& body = ev.body();
     mjData* d = mj_makeData(m);
@@ -180,7 +181,7 @@ TEST(Jump3dController, HipAnglesPointTheLegWhereAsked) {
 // limit and nothing acts on the root, on the plain model replaying the recorded inputs.
 TEST(Jump3dController, HandAuthoredJumpsTakeOffWithinTheLimits) {
   for (const char* task : {"jump_backwards", "robot_jump"}) {
-    const Task t = load_task(kRoot + "/tasks/" + task + ".toml");
+    const Task t = load_task(test_files::jump3d_variant(task).string());
     const TaskEvaluator ev(t);
     const ParameterSet p = ev.load_parameters(t.seed.base);
     auto worker = ev.make_worker();
@@ -216,7 +217,7 @@ TEST(Jump3dController, HandAuthoredJumpsTakeOffWithinTheLimits) {
 // rollouts parted by 0.10 within 20 ms of take-off, the bird's by 0.04 over its push.)
 TEST(Jump3dController, APushOffKeepsNearbyParametersNearby) {
   for (const char* task : {"jump_backwards", "robot_jump"}) {
-    const Task t = load_task(kRoot + "/tasks/" + task + ".toml");
+    const Task t = load_task(test_files::jump3d_variant(task).string());
     const TaskEvaluator ev(t);
     const Eigen::VectorXd x = ev.load_parameters(t.m0).normalized();
     Eigen::VectorXd y = x;
@@ -250,8 +251,8 @@ TEST(Jump3dController, APushOffKeepsNearbyParametersNearby) {
 // that evaluates both) give the same rollouts as on a thread of their own: the stance
 // controller's scratch data follows the model it serves.
 TEST(Jump3dRollouts, TheSameOnAThreadThatServedAnotherCharacter) {
-  const TaskEvaluator human(load_task(kRoot + "/tasks/jump_backwards.toml"));
-  const TaskEvaluator robot(load_task(kRoot + "/tasks/robot_jump.toml"));
+  const TaskEvaluator human(load_task(test_files::jump3d_variant("jump_backwards").string()));
+  const TaskEvaluator robot(load_task(test_files::jump3d_variant("robot_jump").string()));
   const ParameterSet h = human.load_parameters(human.task().m0);
   const ParameterSet r = robot.load_parameters(robot.task().m0);
   auto run = [](const TaskEvaluator& ev, const ParameterSet& p) {

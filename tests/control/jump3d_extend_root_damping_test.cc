@@ -19,6 +19,7 @@
 #include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
+#include "support/jump3d_variant.h"
 
 namespace diverse {
 namespace {
@@ -27,7 +28,7 @@ const std::string kRoot = DIVERSE_SOURCE_DIR;
 
 // The robot's jump task with the damping set to `kd` (0: off).
 Task robot_jump_with(double kd) {
-  Task t = load_task(kRoot + "/tasks/robot_jump.toml");
+  Task t = load_task(test_files::jump3d_variant("robot_jump").string());
   auto c = std::make_shared<Jump3dControllerConfig>(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config));
   c->joint_space_extend = true;
   c->extend_root_kd = kd;
@@ -89,14 +90,14 @@ TakeOffs take_offs(const Task& task, double sigma, int samples) {
 
 TEST(Jump3dExtendRootDamping, IsOffByDefault) {
   EXPECT_EQ(Jump3dControllerConfig{}.extend_root_kd, 0.0);
-  const Task t = load_task(kRoot + "/tasks/jump_backwards.toml");
+  const Task t = load_task(test_files::jump3d_variant("jump_backwards").string());
   EXPECT_EQ(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config).extend_root_kd, 0.0);
 }
 
 TEST(Jump3dExtendRootDamping, NeedsTheJointSpacePushOff) {
   auto variant = [](const std::string& name, const std::string& lines) {
-    return test_files::task_variant("robot_jump", "extend_root_kd_" + name,
-                                    {"joint_space_extend =", "extend_root_kd ="}, {{"controller", lines}})
+    return test_files::task_variant("robot_jump", "extend_root_kd_" + name, {"skill ="},
+                                    {{"controller", "type = \"jump3d\"\n" + lines}})
         .string();
   };
   test_files::expect_task_refused(variant("stance", "joint_space_extend = false\nextend_root_kd = 400"),

@@ -14,6 +14,7 @@
 #include "control/jump3d_controller.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
+#include "support/jump3d_variant.h"
 
 namespace diverse {
 namespace {
@@ -46,7 +47,7 @@ Spread spread(const Task& task, double sigma, int samples) {
 }
 
 TEST(Jump3dJointSpaceExtend, IsOffByDefault) {
-  const Task t = load_task(kRoot + "/tasks/jump_backwards.toml");
+  const Task t = load_task(test_files::jump3d_variant("jump_backwards").string());
   EXPECT_FALSE(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config).joint_space_extend);
 }
 
@@ -69,7 +70,7 @@ TEST(Jump3dJointSpaceExtend, ItsJumpMeetsTheTaskAtBothTimesteps) {
 // stance control's push-off, in its symmetric form (7 and 6 of 16 stand at both).
 TEST(Jump3dJointSpaceExtend, PerturbedJumpsLandAtBothTimestepsNearerEachOther) {
   const Spread joint = spread(load_task(kRoot + "/tests/control/data/robot_jump_joint_space_extend.toml"), 0.005, 16);
-  Task stance_task = load_task(kRoot + "/tasks/robot_jump.toml");
+  Task stance_task = load_task(test_files::jump3d_variant("robot_jump").string());
   auto c = std::make_shared<Jump3dControllerConfig>(
       dynamic_cast<const Jump3dControllerConfig&>(*stance_task.controller_config));
   c->asymmetric = false;

@@ -18,6 +18,7 @@
 #include "physics/drive.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
+#include "support/jump3d_variant.h"
 
 namespace diverse {
 namespace {
@@ -28,7 +29,7 @@ const std::string kRoot = DIVERSE_SOURCE_DIR;
 // stance control, and its input motion of then (tests/control/data/robot_jump.m0.converted.json).
 template <typename Edit>
 Task robot_jump_with(Edit edit) {
-  Task t = load_task(kRoot + "/tasks/robot_jump.toml");
+  Task t = load_task(test_files::jump3d_variant("robot_jump").string());
   t.m0 = kRoot + "/tests/control/data/robot_jump.m0.converted.json";
   auto c = std::make_shared<Jump3dControllerConfig>(dynamic_cast<const Jump3dControllerConfig&>(*t.controller_config));
   c->yaw_kp = c->yaw_kd = c->neck_attitude_kp = c->neck_attitude_kd = 0;

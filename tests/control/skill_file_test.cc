@@ -103,7 +103,8 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
        "modules[0].kp: expected a setting of the \"balance\" module (missing)", false},
       {"unknown_kind", "kind = \"foot_placement\"", "kind = \"foot_planting\"", "foot_planting",
        "modules[1].kind: expected one of \"balance\", \"foot_placement\", \"spotting\", \"stance\", \"simbicon\", "
-       "\"gravity_compensation\", \"stance_support\", \"stance_hip\", got \"foot_planting\"",
+       "\"gravity_compensation\", \"stance_support\", \"stance_hip\", \"stance3d\", \"aim_legs\", \"root_damping\", "
+       "got \"foot_planting\"",
        false},
       {"unknown_condition", "on = \"peak\"", "on = \"apex\"", "apex",
        "phases[3].next[1].on: expected one of \"duration\", \"time\", \"contact\", \"touchdown\", \"liftoff\", "

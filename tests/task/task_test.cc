@@ -115,7 +115,8 @@ TEST_F(TaskFileTest, CommittedTasksParse) {
 // and the robot's seed continuation over the landing distance.
 TEST_F(TaskFileTest, ThreeDimensionalTasksParse) {
   const Task back = load_task(kTasks + "jump_backwards.toml");
-  EXPECT_EQ(back.controller_type->name(), std::string("jump3d"));
+  EXPECT_EQ(back.controller_type->name(), std::string("skill"));
+  EXPECT_EQ(back.controller_config->skill_name(), "jump3d");
   EXPECT_EQ(back.character_spec->name, "human3d");
   EXPECT_DOUBLE_EQ(back.constraints.landing_center, -0.8);
   EXPECT_DOUBLE_EQ(back.constraints.landing_lateral, 0.0);
