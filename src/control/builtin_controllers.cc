@@ -4,7 +4,6 @@
 #include <vector>
 
 #include "control/controller.h"
-#include "control/jump3d_controller.h"
 #include "control/jump_controller.h"
 #include "control/skill_controller.h"
 #include "control/walk_controller.h"
@@ -14,7 +13,6 @@ namespace diverse {
 std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   std::vector<std::unique_ptr<ControllerType>> types;
   types.push_back(std::make_unique<JumpControllerType>());
-  types.push_back(std::make_unique<Jump3dControllerType>());
   types.push_back(std::make_unique<WalkControllerType>());
   types.push_back(std::make_unique<SkillControllerType>());
   return types;

@@ -73,7 +73,7 @@ void ParameterSet::set_from_json(const nlohmann::json& object, const std::string
   for (const auto& [name, value] : object.items()) {
     (void)value;
     if (find(name) >= 0) continue;
-    // A parameter that this controller splits in two (jump3d's `asymmetric`: NAME_left and
+    // A parameter that this controller splits in two (a skill's `sides = true`: NAME_left and
     // NAME_right) is named so that a file written for the shared one says what to do.
     std::string split;
     for (const ParamSpec& s : specs_) {

@@ -129,7 +129,7 @@ class StanceController {
   void set_com_velocity(double x, double y) { velocity_ = {x, y}; }
 
   // Adjustments for a controller that runs stance control as phases of a larger state
-  // machine (control/jump3d_controller.h).
+  // machine (control/module_stance3d.h, a skill's stance phases).
   //
   // Pitches (rad) turn the root, the torso and the feet from their standing orientation
   // about the lateral axis of the heading taken at reset() (positive backwards, as the

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "control/jump_controller.h"
+#include "control/controller.h"
 #include "physics/model.h"
 #include "physics/rollout.h"
 #include "render/offscreen.h"
