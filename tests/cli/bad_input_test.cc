@@ -477,8 +477,8 @@ TEST(BadInput, ReplayAgainstATaskOfAnotherSkill) {
   const std::string motion = (dir / "sim/motion.json").string();
   const Case cases[] = {
       {"replay " + motion + " --task silly_walk",
-       "motion.json: parameters: expected the parameters of controller 'skill' for character 'human3d'"},
-      {"replay " + motion + " --task robot_silly_walk", "motion.json: parameters: expected the parameters of controller"},
+       "motion.json: parameters: expected the parameters of skill 'walk3d' for character 'human3d'"},
+      {"replay " + motion + " --task robot_silly_walk", "motion.json: parameters: expected the parameters of skill 'robot_walk3d'"},
       // A task that names a skill file is named by its skill.
       {"replay " + motion + " --task jump_backwards",
        "motion.json: parameters: expected the parameters of skill 'jump3d' for character 'human3d'"},
