@@ -139,6 +139,18 @@ SkillController::SkillController(const Character& body, const SkillConfig& confi
   state_.hold.assign(n, 0.0);
   qpos0_.assign(n, 0.0);
   for (const SkillPhase& p : skill_->phases) times_.names.push_back(p.name);
+  // Per phase, found once: whether it waits for a lift-off, and which joints' targets its
+  // modules write.
+  for (size_t p = 0; p < skill_->phases.size(); ++p) {
+    bool liftoff = false;
+    for (const SkillTransition& tr : skill_->phases[p].next)
+      for (const SkillCondition& c : tr.on) liftoff = liftoff || c.type == SkillCondition::Type::kLiftoff;
+    liftoff_.push_back(liftoff ? 1 : 0);
+    std::vector<char> owned(n, 0);
+    for (size_t i = 0; i < n; ++i)
+      for (int k : binding_->phases[p].modules) owned[i] = owned[i] || modules_[static_cast<size_t>(k)]->owns_target(static_cast<int>(i));
+    owned_.push_back(owned);
+  }
   times_.begin.assign(skill_->phases.size(), -1.0);
   times_.extend = skill_->phase_index(skill_->push);
   times_.rise = takeoff_;
@@ -393,51 +405,56 @@ void SkillController::enter(int phase, const mjModel* m, const mjData* d) {
 }
 
 bool SkillController::holds(const SkillCondition& c, const mjModel* m, const mjData* d) const {
+  using T = SkillCondition::Type;
   const double elapsed = state_.time - state_.phase_begin;
-  const std::string& k = c.kind;
-  if (k == "duration") return elapsed >= state_.phase_duration;
-  if (k == "time") return elapsed >= c.after;
-  if (k == "contact" || k == "touchdown") return contacts_.any;
-  if (k == "liftoff") {
-    // Airborne: no contact for a while with the COM rising (soft contacts can flicker for
-    // a step while the legs push).
-    return free_since_ >= 0 && state_.time - free_since_ >= c.airborne - 1e-9 && state_.com_vel[2] > 0;
-  }
-  if (k == "peak") return state_.com_vel[2] <= 0;
-  if (k == "turned") return std::fabs(state_.qpos[body_.root_pitch_qpos] - takeoff_pitch_) >= c.angle;
-  if (k == "spotted") {
-    for (int mod : binding_->phases[static_cast<size_t>(state_.phase)].modules) {
-      if (skill_->modules[static_cast<size_t>(mod)].kind == "spotting" && modules_[static_cast<size_t>(mod)]->spotted(state_)) return true;
+  switch (c.type) {
+    case T::kDuration: return elapsed >= state_.phase_duration;
+    case T::kTime: return elapsed >= c.after;
+    case T::kContact: return contacts_.any;
+    case T::kLiftoff:
+      // Airborne: no contact for a while with the COM rising (soft contacts can flicker for
+      // a step while the legs push).
+      return free_since_ >= 0 && state_.time - free_since_ >= c.airborne - 1e-9 && state_.com_vel[2] > 0;
+    case T::kPeak: return state_.com_vel[2] <= 0;
+    case T::kTurned: return std::fabs(state_.qpos[body_.root_pitch_qpos] - takeoff_pitch_) >= c.angle;
+    case T::kSpotted:
+      for (int mod : binding_->phases[static_cast<size_t>(state_.phase)].modules) {
+        if (skill_->modules[static_cast<size_t>(mod)].kind == "spotting" && modules_[static_cast<size_t>(mod)]->spotted(state_)) return true;
+      }
+      return false;
+    case T::kContactMade:
+    case T::kContactLost: {
+      bool touching = false;
+      if (!c.foot.empty()) {
+        // A foot (or a body below it) by side, or by its role in the phase.
+        const int swing = state_.swing;
+        const int side = c.foot == "left" ? 0 : c.foot == "right" ? 1 : c.foot == "swing" ? swing : 1 - swing;
+        touching = contacts_.foot[static_cast<size_t>(side)];
+      } else {
+        int id = -1;
+        for (const auto& [condition, body] : bodies_)
+          if (condition == &c) id = body;
+        for (int i = 0; i < d->ncon && !touching; ++i) {
+          const mjContact& con = d->contact[i];
+          if (con.exclude != 0) continue;
+          touching = m->geom_bodyid[con.geom1] == id || m->geom_bodyid[con.geom2] == id;
+        }
+      }
+      return c.type == T::kContactMade ? touching : !touching;
     }
-    return false;
-  }
-  if ((k == "contact_made" || k == "contact_lost") && !c.foot.empty()) {
-    // A foot (or a body below it) by side, or by its role in the phase.
-    const int swing = state_.swing;
-    const int side = c.foot == "left" ? 0 : c.foot == "right" ? 1 : c.foot == "swing" ? swing : 1 - swing;
-    const bool touching = contacts_.foot[static_cast<size_t>(side)];
-    return k == "contact_made" ? touching : !touching;
-  }
-  if (k == "contact_made" || k == "contact_lost") {
-    int id = -1;
-    for (const auto& [condition, body] : bodies_)
-      if (condition == &c) id = body;
-    bool touching = false;
-    for (int i = 0; i < d->ncon && !touching; ++i) {
-      const mjContact& con = d->contact[i];
-      if (con.exclude != 0) continue;
-      touching = m->geom_bodyid[con.geom1] == id || m->geom_bodyid[con.geom2] == id;
-    }
-    return k == "contact_made" ? touching : !touching;
+    case T::kFeature: break;
   }
   // A feature crossing a threshold.
+  using F = SkillCondition::Feature;
   double v = 0;
-  if (c.feature == "com_x") v = state_.com[0];
-  else if (c.feature == "com_z") v = state_.com[2];
-  else if (c.feature == "com_vx") v = state_.com_vel[0];
-  else if (c.feature == "com_vz") v = state_.com_vel[2];
-  else if (c.feature == "pitch") v = state_.qpos[body_.root_pitch_qpos];
-  else v = d->qvel[body_.root_pitch_dof];
+  switch (c.which) {
+    case F::kComX: v = state_.com[0]; break;
+    case F::kComZ: v = state_.com[2]; break;
+    case F::kComVx: v = state_.com_vel[0]; break;
+    case F::kComVz: v = state_.com_vel[2]; break;
+    case F::kPitch: v = state_.qpos[body_.root_pitch_qpos]; break;
+    case F::kPitchRate: v = d->qvel[body_.root_pitch_dof]; break;
+  }
   return c.above ? v >= c.threshold : v <= c.threshold;
 }
 
@@ -459,10 +476,7 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
   // 2. Transitions: at most one per step, the first whose conditions all hold.
   state_.phase_changed = false;
   const SkillPhase& phase = skill_->phases[phase0];
-  bool liftoff = false;
-  for (const SkillTransition& tr : phase.next)
-    for (const SkillCondition& c : tr.on) liftoff = liftoff || c.kind == "liftoff";
-  if (liftoff) {
+  if (liftoff_[phase0]) {
     if (contacts.any) free_since_ = -1;
     else if (free_since_ < 0) free_since_ = t;
   }
@@ -477,7 +491,7 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
     if (!all) continue;
     if (tr.gave_up) gave_up_ = true;
     for (const std::string& passed : tr.passes) times_.begin[static_cast<size_t>(skill_->phase_index(passed))] = t;
-    enter(skill_->phase_index(tr.to), m, d);
+    enter(skill_->phase_index(tr.to), m, d);  // once per phase: the names are looked up then
     break;
   }
 
@@ -490,10 +504,9 @@ void SkillController::control(const mjModel* m, mjData* d, const ContactState& c
   state_.progress = s;
   if (heading_frame_) state_.heading = root_heading(d, root, standing_);
   state_.double_support = pb.swing >= 0 && !pb.swing_lands && contacts.foot[static_cast<size_t>(pb.swing)];
+  const std::vector<char>& owned = owned_[p];
   for (size_t i = 0; i < body_.joints.size(); ++i) {
-    bool skip = false;
-    for (int k : pb.modules) skip = skip || modules_[static_cast<size_t>(k)]->owns_target(static_cast<int>(i));
-    if (skip) continue;
+    if (owned[i]) continue;
     const SkillJointTarget& jt = pb.targets[i];
     const bool tracked = jt.world == SkillTarget::World::kParent || jt.world == SkillTarget::World::kChild;
     if (jt.value->kind == SkillValue::Kind::kCurve) {

@@ -128,6 +128,8 @@ class SkillController : public Controller {
   double takeoff_pitch_ = 0;  // root pitch at take-off (rad)
   std::vector<std::pair<const SkillCondition*, int>> bodies_;  // conditions' bodies: MuJoCo ids
   std::vector<double> qpos0_;      // per joint: its angle in the standing pose
+  std::vector<char> liftoff_;                // per phase: a transition waits for a lift-off
+  std::vector<std::vector<char>> owned_;     // per phase, per joint: a module writes its target
   std::vector<DampedDof> damped_;  // scratch: a tracked joint's damped velocity
   SubtreeComVelocity com_velocity_;  // of the character's subtree, set by reset()
   // Free roots: whether any phase tracks the root or a link in the heading frame, the

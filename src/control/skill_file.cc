@@ -207,6 +207,20 @@ const std::vector<std::string> kConditions = {"duration", "time",         "conta
                                               "turned",   "spotted",      "feature"};
 const std::vector<std::string> kFeatures = {"com_x", "com_z", "com_vx", "com_vz", "pitch", "pitch_rate"};
 
+SkillCondition::Type condition_type(const std::string& kind) {
+  using T = SkillCondition::Type;
+  if (kind == "duration") return T::kDuration;
+  if (kind == "time") return T::kTime;
+  if (kind == "contact" || kind == "touchdown") return T::kContact;
+  if (kind == "liftoff") return T::kLiftoff;
+  if (kind == "contact_made") return T::kContactMade;
+  if (kind == "contact_lost") return T::kContactLost;
+  if (kind == "peak") return T::kPeak;
+  if (kind == "turned") return T::kTurned;
+  if (kind == "spotted") return T::kSpotted;
+  return T::kFeature;
+}
+
 std::string quoted_list(const std::vector<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += std::string(s.empty() ? "\"" : ", \"") + n + "\"";
@@ -270,6 +284,9 @@ SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
       c.threshold = r.number(c.above ? "above" : "below", -1e6, 1e6);
       used.insert(c.above ? "above" : "below");
     }
+    c.type = condition_type(c.kind);
+    c.which = static_cast<SkillCondition::Feature>(
+        std::max<std::ptrdiff_t>(0, std::find(kFeatures.begin(), kFeatures.end(), c.feature) - kFeatures.begin()));
     tr.on.push_back(c);
   }
   for (const char* key : {"after", "for", "angle", "body", "foot", "feature", "above", "below"}) {

@@ -96,6 +96,12 @@ struct SkillCondition {
   std::string foot;        // contact_made, contact_lost: instead of a body, "swing", "stance", "left", "right"
   std::string feature;     // feature: com_x, com_z, com_vx, com_vz, pitch, pitch_rate
   bool above = true;       // feature: crosses above (true) or below `threshold`
+  // `kind` and `feature` as the engine tries them every step (set with them when the file
+  // is read: no string is compared in a step).
+  enum class Type { kDuration, kTime, kContact, kLiftoff, kContactMade, kContactLost, kPeak, kTurned, kSpotted, kFeature };
+  Type type = Type::kDuration;
+  enum class Feature { kComX, kComZ, kComVx, kComVz, kPitch, kPitchRate };
+  Feature which = Feature::kComX;
   double threshold = 0;
 };
 
