@@ -1,74 +1,122 @@
 // The SIMBICON walks as skill files (skills/walk3d.toml, skills/robot_walk3d.toml): each
 // walk task, which names its skill, gives its committed input motion the same rollout
-// under the skill engine (control/skill_controller.h) as under the "walk3d" controller the
-// task named before: the same parameter names, ranges and order, and the same qpos and
-// ctrl at every step to the last bit, at the task's timestep and at half of it, the same
-// phase times and the same C.
+// under the skill engine (control/skill_controller.h) as the "walk3d" controller gave it
+// before the walk was a skill file: the same parameter names, ranges and order, and the
+// same qpos and ctrl at every step to the last bit, at the task's timestep and at half of
+// it, the same phase times and the same C.
+//
+// tests/control/data/walk_replay_reference.txt holds what walk3d did, written by this test
+// from the walk3d controller (DIVERSE_WRITE_WALK_REFERENCE=1, while walk3d existed): per
+// task and timestep the number of steps, the phase times and C (as hexadecimal floats,
+// exact) and a 64-bit FNV-1a hash of the bytes of qpos and ctrl over every 100 steps (so
+// a difference is found to within 100 steps).
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "physics/rollout.h"
 #include "support/task_variant.h"
+#include "support/text_files.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
 namespace diverse {
 namespace {
 
+const std::string kReference = std::string(DIVERSE_SOURCE_DIR) + "/tests/control/data/walk_replay_reference.txt";
+constexpr int kChunk = 100;  // steps per hash
+
+std::string hex(double v) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%a", v);
+  return text;
+}
+
+uint64_t fnv1a(const double* begin, size_t count, uint64_t h = 1469598103934665603ull) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(begin);
+  for (size_t i = 0; i < count * sizeof(double); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  return h;
+}
+
+// The lines that describe one rollout of `task`'s input motion at `scale` times its step.
+std::vector<std::string> describe(const Task& task, const std::string& name, double scale) {
+  const TaskEvaluator eval(task);
+  const ParameterSet m0 = eval.load_parameters(task.m0);
+  StepRecorder record;
+  EvaluationOptions o;
+  o.timestep_scale = scale;
+  o.recorder = &record;
+  auto worker = eval.make_worker();
+  const Evaluation e = eval.evaluate(m0.values(), *worker, o);
+  std::vector<std::string> lines;
+  const std::string head = name + " x" + hex(scale) + " ";
+  lines.push_back(head + "steps " + std::to_string(record.steps()));
+  lines.push_back(head + "C " + hex(e.constraint));
+  std::string times;
+  for (size_t p = 0; p < e.phases.begin.size(); ++p) times += " " + e.phases.names[p] + "=" + hex(e.phases.begin[p]);
+  lines.push_back(head + "phases" + times);
+  std::string params;
+  for (const ParamSpec& s : m0.specs()) params += " " + s.name + "[" + hex(s.lower) + "," + hex(s.upper) + "]";
+  lines.push_back(head + "parameters" + params);
+  lines.push_back(head + "qpos0 " + std::to_string(fnv1a(record.qpos0.data(), record.qpos0.size())));
+  const size_t nq = static_cast<size_t>(record.nq), nu = static_cast<size_t>(record.nu);
+  for (int first = 0; first < record.steps(); first += kChunk) {
+    const size_t n = static_cast<size_t>(std::min(kChunk, record.steps() - first));
+    const uint64_t h = fnv1a(record.ctrl.data() + first * nu, n * nu, fnv1a(record.qpos.data() + first * nq, n * nq));
+    lines.push_back(head + "steps " + std::to_string(first) + "+ " + std::to_string(h));
+  }
+  return lines;
+}
+
 class WalkReplay : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(WalkReplay, SameQposAtEveryStepAsWalk3d) {
+TEST_P(WalkReplay, SameRolloutAsWalk3dGave) {
   const std::string name = GetParam();
-  const Task old_task = load_task(
-      test_files::task_variant(name, std::string("walk_replay_") + name, {"skill =", "# SIMBICON walking as"},
-                               {{"controller", "type = \"walk3d\""}})
-          .string());
-  ASSERT_EQ(old_task.controller, "walk3d");
-  const Task new_task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + name + ".toml");
-  ASSERT_EQ(new_task.controller, "skill");
-  ASSERT_TRUE(new_task.walk.enabled);
-  const TaskEvaluator old_eval(old_task), new_eval(new_task);
-  const ParameterSet old_params = old_eval.parameters(), new_params = new_eval.parameters();
-  ASSERT_EQ(old_params.size(), new_params.size());
-  for (size_t i = 0; i < old_params.specs().size(); ++i) {
-    const ParamSpec& a = old_params.specs()[i];
-    const ParamSpec& b = new_params.specs()[i];
-    EXPECT_EQ(a.name, b.name) << i;
-    EXPECT_EQ(a.lower, b.lower) << a.name;
-    EXPECT_EQ(a.upper, b.upper) << a.name;
-    EXPECT_EQ(a.unit, b.unit) << a.name;
+  const Task task = load_task(std::string(DIVERSE_SOURCE_DIR) + "/tasks/" + name + ".toml");
+  ASSERT_EQ(task.controller, "skill");
+  ASSERT_TRUE(task.walk.enabled);
+  std::vector<std::string> expected;
+  {
+    std::istringstream in(test_files::read_text(kReference));
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(name + " x", 0) == 0) expected.push_back(line);
   }
-  const ParameterSet m0 = old_eval.load_parameters(old_task.m0);
+  std::vector<std::string> got;
   for (double scale : {1.0, 0.5}) {
-    StepRecorder old_record, new_record;
-    EvaluationOptions o;
-    o.timestep_scale = scale;
-    o.recorder = &old_record;
-    auto ow = old_eval.make_worker();
-    const Evaluation a = old_eval.evaluate(m0.values(), *ow, o);
-    o.recorder = &new_record;
-    auto nw = new_eval.make_worker();
-    const Evaluation b = new_eval.evaluate(m0.values(), *nw, o);
-    ASSERT_GT(old_record.steps(), 1000);
-    EXPECT_EQ(old_record.qpos0, new_record.qpos0) << "timestep x" << scale;
-    ASSERT_EQ(old_record.qpos.size(), new_record.qpos.size()) << "timestep x" << scale;
-    size_t first = old_record.qpos.size();
-    for (size_t i = 0; i < old_record.qpos.size() && first == old_record.qpos.size(); ++i) {
-      if (old_record.qpos[i] != new_record.qpos[i]) first = i;
-    }
-    EXPECT_EQ(first, old_record.qpos.size()) << "timestep x" << scale << ": qpos differs first at step "
-                                             << first / static_cast<size_t>(old_record.nq);
-    EXPECT_TRUE(old_record.ctrl == new_record.ctrl) << "timestep x" << scale;
-    EXPECT_EQ(a.constraint, b.constraint);
-    EXPECT_EQ(a.constraint, 0.0) << "the input walk meets its task";
-    EXPECT_EQ(a.phases.names, b.phases.names);
-    for (size_t p = 0; p < a.phases.begin.size(); ++p) EXPECT_EQ(a.phases.begin[p], b.phases.begin[p]) << p;
+    const std::vector<std::string> lines = describe(task, name, scale);
+    EXPECT_EQ(lines[1], name + " x" + hex(scale) + " C 0x0p+0") << "the input walk meets its task";
+    got.insert(got.end(), lines.begin(), lines.end());
   }
+  ASSERT_GT(expected.size(), 40u) << kReference;
+  ASSERT_EQ(got.size(), expected.size());
+  // The first line that differs (a chunk of 100 steps, or a figure).
+  for (size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], expected[i]) << "line " << i;
 }
 
 INSTANTIATE_TEST_SUITE_P(Walks, WalkReplay, ::testing::Values("silly_walk", "robot_silly_walk"),
                          [](const ::testing::TestParamInfo<const char*>& param) { return std::string(param.param); });
+
+// Writes the reference from the walk3d controller (the task files as they named it).
+TEST(WalkReplayReference, WrittenFromWalk3dWhenAsked) {
+  if (std::getenv("DIVERSE_WRITE_WALK_REFERENCE") == nullptr) GTEST_SKIP() << "DIVERSE_WRITE_WALK_REFERENCE not set";
+  std::ofstream out(kReference);
+  for (const char* name : {"silly_walk", "robot_silly_walk"}) {
+    const Task old_task = load_task(test_files::task_variant(name, std::string("walk_reference_") + name,
+                                                             {"skill =", "# SIMBICON walking as"},
+                                                             {{"controller", "type = \"walk3d\""}})
+                                        .string());
+    ASSERT_EQ(old_task.controller, "walk3d");
+    for (double scale : {1.0, 0.5})
+      for (const std::string& line : describe(old_task, name, scale)) out << line << "\n";
+  }
+}
 
 }  // namespace
 }  // namespace diverse
