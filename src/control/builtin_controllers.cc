@@ -6,14 +6,12 @@
 #include "control/controller.h"
 #include "control/jump_controller.h"
 #include "control/skill_controller.h"
-#include "control/walk_controller.h"
 
 namespace diverse {
 
 std::vector<std::unique_ptr<ControllerType>> builtin_controllers() {
   std::vector<std::unique_ptr<ControllerType>> types;
   types.push_back(std::make_unique<JumpControllerType>());
-  types.push_back(std::make_unique<WalkControllerType>());
   types.push_back(std::make_unique<SkillControllerType>());
   return types;
 }

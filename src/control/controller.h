@@ -77,6 +77,11 @@ class Controller {
   virtual int phase() const = 0;
   virtual bool phase_changed() const = 0;  // in the last control()
   virtual const PhaseTimes& phase_times() const = 0;
+  // The leg that swings in `phase` (0 left, 1 right), or -1: a walk's steps (task/walk_eval.h).
+  virtual int swing_leg(int phase) const {
+    (void)phase;
+    return -1;
+  }
   // The motion gave up before leaving the ground (a push that never took off).
   virtual bool gave_up() const = 0;
   // Whole-body COM (m) and its velocity (m/s) seen by the last control() step.

@@ -17,19 +17,22 @@ SimbiconModule::SimbiconModule(const SkillModuleSpec& spec, const ModuleSettings
 void SimbiconModule::set_targets(const mjModel* m, const mjData* d, SkillState& s) {
   if (s.swing < 0) return;
   const Character& body = *s.body;
-  // The COM velocity: the links' momenta over the mass.
-  double p[3] = {0, 0, 0};
-  for (int b : body.links) {
-    const double* v = d->cvel + 6 * b;
-    const double* o = d->subtree_com + 3 * m->body_rootid[b];
-    const double r[3] = {d->xipos[3 * b] - o[0], d->xipos[3 * b + 1] - o[1], d->xipos[3 * b + 2] - o[2]};
-    double w_r[3];
-    mju_cross(w_r, v, r);
-    for (int i = 0; i < 3; ++i) p[i] += m->body_mass[b] * (v[3 + i] + w_r[i]);
+  // The COM velocity: the links' momenta over the mass (once a step for every module).
+  if (s.link_com_vel_time != s.time) {
+    double p[3] = {0, 0, 0};
+    for (int b : body.links) {
+      const double* v = d->cvel + 6 * b;
+      const double* o = d->subtree_com + 3 * m->body_rootid[b];
+      const double r[3] = {d->xipos[3 * b] - o[0], d->xipos[3 * b + 1] - o[1], d->xipos[3 * b + 2] - o[2]};
+      double w_r[3];
+      mju_cross(w_r, v, r);
+      for (int i = 0; i < 3; ++i) p[i] += m->body_mass[b] * (v[3 + i] + w_r[i]);
+    }
+    const double mass = m->body_subtreemass[body.root_body];
+    for (size_t i = 0; i < 3; ++i) s.link_com_vel[i] = p[i] / mass;
+    s.link_com_vel_time = s.time;
   }
-  const double mass = m->body_subtreemass[body.root_body];
-  double vel[3];
-  for (int i = 0; i < 3; ++i) vel[i] = p[i] / mass;
+  const double* vel = s.link_com_vel.data();
 
   const int swing = s.swing, stance = 1 - swing;
   const double ch = std::cos(s.heading), sh = std::sin(s.heading);

@@ -96,6 +96,7 @@ class SkillController : public Controller {
   int phase() const override { return state_.phase; }
   bool phase_changed() const override { return state_.phase_changed; }
   const PhaseTimes& phase_times() const override { return times_; }
+  int swing_leg(int phase) const override { return binding_->phases[static_cast<size_t>(phase)].swing; }
   bool gave_up() const override { return gave_up_; }
   const std::array<double, 3>& com() const override { return state_.com; }
   const std::array<double, 3>& com_velocity() const override { return state_.com_vel; }

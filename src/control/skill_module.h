@@ -62,6 +62,10 @@ struct SkillState {
   // The torques about to be asked for: per joint u (Nm, all but the joint's own damping)
   // and the damping gain kd (Nm s/rad), the drive applying u - kd qdot within the limit.
   std::vector<double> u, damping;
+  // Scratch a module may share with the others of the phase in one step: the COM velocity
+  // as the sum of the links' momenta (module_simbicon.h) and the time it was computed at.
+  std::array<double, 3> link_com_vel{};
+  double link_com_vel_time = -1;
 };
 
 class SkillModule {

@@ -5,14 +5,11 @@
 
 #include <Eigen/Geometry>
 
-#include "control/walk_controller.h"
 #include "task/walk_audit.h"
 #include "task/walk_task.h"
 
 namespace diverse {
 namespace {
-
-bool is_lift(int state) { return state == kLeftLift || state == kRightLift; }
 
 // World orientation of every body at the model's qpos0 (hinges add no rotation there).
 std::vector<std::array<double, 4>> standing_orientations(const mjModel* m) {
@@ -188,17 +185,18 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
     state_time_.clear();
     state_qpos_.clear();
     state_ = state;
-    if (is_lift(state)) {
-      // A strike state ended: a touch-down, or a swing foot that never came down.
-      if (!contacts_.foot[static_cast<size_t>(swing_leg(ended))]) {
+    if (controller_.swing_leg(state) != controller_.swing_leg(ended)) {
+      // A step's last phase ended (the other leg swings now): a touch-down, or a swing
+      // foot that never came down.
+      if (!contacts_.foot[static_cast<size_t>(controller_.swing_leg(ended))]) {
         return fall(d, "the swing foot did not come down");
       }
       ++strikes_;
-      if (state == kLeftLift) stride_heading_ = raw;  // a stride begins
+      if (state == 0) stride_heading_ = raw;  // a stride begins (the skill's first phase)
       if (strikes_ == w.steps) {
         complete_ = recording_;  // the last evaluated stride has ended
         recording_ = false;
-      } else if (state == kLeftLift && strikes_ >= w.settle_steps && strikes_ < w.steps) {
+      } else if (state == 0 && strikes_ >= w.settle_steps && strikes_ < w.steps) {
         recording_ = true;  // a stride begins after the walk has settled
       }
     }

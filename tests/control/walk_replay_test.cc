@@ -5,24 +5,21 @@
 // same qpos and ctrl at every step to the last bit, at the task's timestep and at half of
 // it, the same phase times and the same C.
 //
-// tests/control/data/walk_replay_reference.txt holds what walk3d did, written by this test
-// from the walk3d controller (DIVERSE_WRITE_WALK_REFERENCE=1, while walk3d existed): per
-// task and timestep the number of steps, the phase times and C (as hexadecimal floats,
+// tests/control/data/walk_replay_reference.txt holds what walk3d did, written by describe()
+// below from the walk3d controller before it was removed (the task files as they named it,
+// `type = "walk3d"`): per task and timestep the number of steps, the phase times and C (as hexadecimal floats,
 // exact) and a 64-bit FNV-1a hash of the bytes of qpos and ctrl over every 100 steps (so
 // a difference is found to within 100 steps).
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "physics/rollout.h"
-#include "support/task_variant.h"
 #include "support/text_files.h"
 #include "task/evaluate.h"
 #include "task/task.h"
@@ -102,21 +99,6 @@ TEST_P(WalkReplay, SameRolloutAsWalk3dGave) {
 
 INSTANTIATE_TEST_SUITE_P(Walks, WalkReplay, ::testing::Values("silly_walk", "robot_silly_walk"),
                          [](const ::testing::TestParamInfo<const char*>& param) { return std::string(param.param); });
-
-// Writes the reference from the walk3d controller (the task files as they named it).
-TEST(WalkReplayReference, WrittenFromWalk3dWhenAsked) {
-  if (std::getenv("DIVERSE_WRITE_WALK_REFERENCE") == nullptr) GTEST_SKIP() << "DIVERSE_WRITE_WALK_REFERENCE not set";
-  std::ofstream out(kReference);
-  for (const char* name : {"silly_walk", "robot_silly_walk"}) {
-    const Task old_task = load_task(test_files::task_variant(name, std::string("walk_reference_") + name,
-                                                             {"skill =", "# SIMBICON walking as"},
-                                                             {{"controller", "type = \"walk3d\""}})
-                                        .string());
-    ASSERT_EQ(old_task.controller, "walk3d");
-    for (double scale : {1.0, 0.5})
-      for (const std::string& line : describe(old_task, name, scale)) out << line << "\n";
-  }
-}
 
 }  // namespace
 }  // namespace diverse

@@ -7,10 +7,10 @@
 #include "control/controller.h"
 #include "control/parameters.h"
 #include "control/stance_controller.h"
-#include "control/walk_controller.h"
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/drive.h"
+#include "task/task.h"
 
 namespace diverse::test_support {
 namespace fs = std::filesystem;
@@ -30,28 +30,29 @@ class Hooks : public StepHooks {
 
 class WalkHooks : public StepHooks {
  public:
-  WalkHooks(const Character& body, WalkController& walk, JointDrive& drive, int steps, WalkMotion& out)
+  WalkHooks(const Character& body, Controller& walk, JointDrive& drive, int steps, WalkMotion& out)
       : body_(body), walk_(walk), drive_(drive), steps_(steps), out_(out) {}
   void control(mjModel* m, mjData* d) override {
     contacts_ = scan_contacts(m, d, body_);
     if (first_) {
       walk_.reset(m, d);
       first_ = false;
-      out_.phases.emplace_back(walk_state_name(walk_.phase()), d->time);
+      out_.phases.emplace_back(walk_.phase_times().names[static_cast<size_t>(walk_.phase())], d->time);
     }
     walk_.control(m, d, contacts_, drive_);
   }
   bool observe(const mjModel*, const mjData* d) override {
     if (walk_.phase_changed() && d->time > 0) {
-      out_.phases.emplace_back(walk_state_name(walk_.phase()), d->time);
-      if (walk_.phase() == kLeftLift || walk_.phase() == kRightLift) ++touchdowns_;
+      const int phase = walk_.phase();
+      out_.phases.emplace_back(walk_.phase_times().names[static_cast<size_t>(phase)], d->time);
+      if (phase == 0 || phase == 2) ++touchdowns_;  // a lift phase begins: the other foot came down
     }
     return contacts_.non_foot || touchdowns_ >= steps_;
   }
 
  private:
   const Character& body_;
-  WalkController& walk_;
+  Controller& walk_;
   JointDrive& drive_;
   int steps_;
   WalkMotion& out_;
@@ -99,19 +100,19 @@ WalkMotion walk_motion(const std::string& character, const std::string& paramete
   WalkMotion out;
   out.model = SharedModel::from_file(spec->model);
   const Character body = bind_character(spec, out.model->get(), spec->model);
-  const std::vector<ParamSpec> specs = WalkController::parameter_specs(body);
+  // The character's walk task names its skill (skills/walk3d.toml, skills/robot_walk3d.toml).
+  const Task task = load_task(root + "/tasks/" + (character == "human3d" ? "silly_walk" : "robot_silly_walk") + ".toml");
+  const std::vector<ParamSpec> specs = task.controller_type->parameter_specs(body, *task.controller_config);
   ParameterSet values(specs, std::vector<double>(specs.size(), 0.0));
   const std::string file = root + "/tasks/" + parameters;
   std::ifstream in(file);
   values.set_from_json(nlohmann::json::parse(in).at("parameters"), file);
-  WalkControllerConfig config;
-  WalkController walk(body, config);
-  walk.set_parameters(values.values());
+  const std::unique_ptr<Controller> walk = task.controller_type->make(body, *task.controller_config, values.values());
   SimWorker worker(out.model);
   worker.reset();
-  walk.start_state(worker.model(), worker.data());
+  walk->start_state(worker.model(), worker.data());
   JointDrive drive = make_drive(body);
-  WalkHooks hooks(body, walk, drive, steps, out);
+  WalkHooks hooks(body, *walk, drive, steps, out);
   run_rollout(worker, hooks, static_cast<int>(60.0 / worker.model()->opt.timestep), drive, &out.record);
   return out;
 }

@@ -1,7 +1,7 @@
 // 3D motions for the viewing and export tests, made without a 3D task: a character of
 // assets/characters standing under stance control (control/stance_controller.h) from an
 // initial root velocity (a push; never an external force), or walking under SIMBICON
-// control (control/walk_controller.h), recorded for exact replay, and run directories of
+// control (skills/walk3d.toml on the skill engine), recorded for exact replay, and run directories of
 // such motions laid out as `diverse run` writes one (run.json, summary.json,
 // motions/m<i>.json with model/m<i>.xml), so render, gallery and export read them as any
 // run. Stance motions have no phases; walks have their states. Neither has distances.
@@ -33,7 +33,7 @@ StanceMotion stance_motion(const std::string& character, const std::array<double
 void write_stance_run(const std::filesystem::path& dir, const std::string& character,
                       const std::vector<std::array<double, 3>>& pushes, double seconds);
 
-// A walk: `character` under SIMBICON walking (control/walk_controller.h) with the parameters
+// A walk: `character` under SIMBICON walking (its walk task's skill file) with the parameters
 // of tasks/<parameters> from its static start, until `steps` swing-foot touch-downs (or a
 // fall), recorded for exact replay. Its phases are every state the walk entered, in order
 // (the names repeat stride after stride).

@@ -66,7 +66,7 @@ class TaskFileTest : public ::testing::Test {
 // controller that cannot drive the character says why before any simulation.
 TEST_F(TaskFileTest, ControllerTypeIsLookedUpAndCheckedAgainstTheCharacter) {
   EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"walk9\"")),
-            ": controller.type: expected one of \"jump2d\", \"walk3d\", \"skill\", got \"walk9\"");
+            ": controller.type: expected one of \"jump2d\", \"skill\", got \"walk9\"");
   EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"jump2d\"\nbounce = 2")),
             ": controller.bounce: expected no such key (unknown key; known keys: type, landing_control, "
             "landing_height, extend_timeout, tuck_time, open_time, open_rotation, open_turn, balance_kp, balance_kd, balance_max_force, crouch_lean, gravity_compensation, "

@@ -68,7 +68,7 @@ std::string walk_text() {
          "variations = 4\n"
          "m0 = \"w.m0.json\"\n"
          "[controller]\n"
-         "type = \"walk3d\"\n"
+         "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/walk3d.toml\"\n"
          "[constraints]\n"
          "weight = 5000.0\n"
          "fall_penalty = 50000.0\n"
@@ -129,9 +129,9 @@ TEST(WalkTaskFile, BadInputIsOneLine) {
   EXPECT_PRED2(starts, error_of(replace(walk_text(), "half_width = 0.5 }", "half = 0.5 }")),
                ": walk.forward.half: expected no such key");
   EXPECT_EQ(error_of(replace(walk_text(), "[walk]\nsteps = 30\nsettle_steps = 10\nforward = { center = 1.0, half_width = 0.5 }\n", "")),
-            ": walk: expected a [walk] table for the walk controller \"walk3d\" (missing)");
+            ": walk: expected a [walk] table for the walk controller \"skill\" (missing)");
   const std::string jump = replace(replace(walk_text(), "human3d.toml", "human2d.toml"), "walk3d", "jump2d");
-  EXPECT_EQ(error_of(jump), ": walk: expected no [walk] table: the controller \"jump2d\" does not walk");
+  EXPECT_EQ(error_of(jump), ": walk: expected no [walk] table: the controller \"skill\" does not walk");
 }
 
 // The constraint penalty on made-up walks.

@@ -1,4 +1,5 @@
-// SIMBICON walking (control/walk_controller.h) on the 3D human and the bird robot, from the
+// SIMBICON walking (skills/walk3d.toml, skills/robot_walk3d.toml, run by the skill engine
+// control/skill_controller.h as the walk tasks name them) on the 3D human and the bird robot, from the
 // hand-authored parameters committed as the walk tasks' starting points
 // (tasks/silly_walk_start.json, tasks/robot_silly_walk_start.json): from a static start
 // in the first state's pose each walks 30 steps without a fall, and over the last 20
@@ -6,10 +7,8 @@
 // pelvis and torso stay within 15 degrees of vertical, the stance sole never leaves the
 // floor at a touch-down, every net joint torque stays within its limit at every step, and
 // the record replays exactly. A step is a swing-foot touch-down that ends a strike
-// state; its length is the new stance foot's position minus the previous one's, in the
+// phase; its length is the new stance foot's position minus the previous one's, in the
 // heading frame at the touch-down.
-#include "control/walk_controller.h"
-
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -24,12 +23,16 @@
 #include <vector>
 
 #include "character/character.h"
+#include "control/heading_frame.h"
 #include "control/parameters.h"
+#include "control/skill_controller.h"
 #include "core/error.h"
 #include "core/toml_reader.h"
 #include "physics/drive.h"
 #include "physics/model.h"
 #include "physics/rollout.h"
+#include "task/evaluate.h"
+#include "task/task.h"
 
 namespace diverse {
 namespace {
@@ -37,6 +40,7 @@ namespace {
 const std::string kRoot = DIVERSE_SOURCE_DIR;
 
 struct Loaded {
+  Task task;  // the walk task of the character, which names its skill
   std::shared_ptr<const CharacterSpec> spec;
   std::shared_ptr<const SharedModel> model;
   Character body;
@@ -44,16 +48,24 @@ struct Loaded {
 
 Loaded load(const std::string& name) {
   Loaded l;
+  l.task = load_task(kRoot + "/tasks/" + std::string(name == std::string("human3d") ? "silly_walk" : "robot_silly_walk") + ".toml");
   l.spec = std::make_shared<CharacterSpec>(load_character_file(kRoot + "/assets/characters/" + name + ".toml"));
   l.model = SharedModel::from_file(l.spec->model);
   l.body = bind_character(l.spec, l.model->get(), l.spec->model);
   return l;
 }
 
-// The values of a {"parameters": {...}} file in parameter_specs() order.
-std::vector<double> read_values(const Character& body, const std::string& file) {
-  ParameterSet p(WalkController::parameter_specs(body),
-                 std::vector<double>(WalkController::parameter_specs(body).size(), 0.0));
+std::vector<ParamSpec> specs_of(const Loaded& l, const Character& body) {
+  return l.task.controller_type->parameter_specs(body, *l.task.controller_config);
+}
+
+std::unique_ptr<Controller> make(const Loaded& l, const Character& body, const std::vector<double>& values) {
+  return l.task.controller_type->make(body, *l.task.controller_config, values);
+}
+
+// The values of a {"parameters": {...}} file in parameter order.
+std::vector<double> read_values(const Loaded& l, const Character& body, const std::string& file) {
+  ParameterSet p(specs_of(l, body), std::vector<double>(specs_of(l, body).size(), 0.0));
   std::ifstream in(file);
   const nlohmann::json j = nlohmann::json::parse(in);
   p.set_from_json(j.at("parameters"), file);
@@ -82,13 +94,14 @@ double tilt_deg(const mjData* d, int body) {
 
 class WalkHooks : public StepHooks {
  public:
-  WalkHooks(const Character& body, WalkController& walk, JointDrive& drive, int torso, int max_steps,
+  WalkHooks(const Character& body, Controller& walk, JointDrive& drive, int torso, int max_steps,
             Outcome& out)
       : body_(body), walk_(walk), drive_(drive), torso_(torso), max_steps_(max_steps), out_(out) {}
 
   void control(mjModel* m, mjData* d) override {
     contacts_ = scan_contacts(m, d, body_);
     if (first_) {
+      standing_ = standing_frames(m, body_.root_body);
       walk_.reset(m, d);
       const double* f = d->xpos + 3 * body_.feet[1];  // the first stance foot: right
       last_ = {f[0], f[1]};
@@ -100,10 +113,11 @@ class WalkHooks : public StepHooks {
   bool observe(const mjModel*, const mjData* d) override {
     tilt_ = std::max({tilt_, tilt_deg(d, body_.root_body), torso_ >= 0 ? tilt_deg(d, torso_) : 0.0});
     const int state = walk_.phase();
-    if (walk_.phase_changed() && (state == kLeftLift || state == kRightLift) && d->time > 0) {
-      const int leg = state == kRightLift ? 0 : 1;  // the leg that just touched down
+    // A lift phase (0 left, 2 right) begins: the other leg just touched down.
+    if (walk_.phase_changed() && (state == 0 || state == 2) && d->time > 0) {
+      const int leg = state == 2 ? 0 : 1;  // the leg that just touched down
       const double* f = d->xpos + 3 * body_.feet[static_cast<size_t>(leg)];
-      const double h = walk_.heading(), dx = f[0] - last_[0], dy = f[1] - last_[1];
+      const double h = root_heading(d, body_.root_body, standing_), dx = f[0] - last_[0], dy = f[1] - last_[1];
       out_.steps.push_back({leg, d->time, std::cos(h) * dx + std::sin(h) * dy, -std::sin(h) * dx + std::cos(h) * dy});
       out_.tilt_deg_after.push_back(tilt_);
       tilt_ = 0;
@@ -118,8 +132,9 @@ class WalkHooks : public StepHooks {
 
  private:
   const Character& body_;
-  WalkController& walk_;
+  Controller& walk_;
   JointDrive& drive_;
+  StandingFrames standing_;
   int torso_;
   int max_steps_;
   Outcome& out_;
@@ -142,15 +157,13 @@ Outcome walk(const Loaded& l, const std::string& params, int steps, double times
   auto model = SharedModel::from_xml(xml, l.spec->model);
   const Character body = bind_character(l.spec, model->get(), l.spec->model);
 
-  WalkControllerConfig config;
-  WalkController c(body, config);
-  c.set_parameters(read_values(body, params));
+  const std::unique_ptr<Controller> c = make(l, body, read_values(l, body, params));
   SimWorker worker(model);
   worker.reset();
-  EXPECT_TRUE(c.start_state(worker.model(), worker.data()));
+  EXPECT_TRUE(c->start_state(worker.model(), worker.data()));
   JointDrive drive = make_drive(body);
   const int torso = mj_name2id(model->get(), mjOBJ_BODY, "torso");
-  WalkHooks hooks(body, c, drive, torso == body.root_body ? -1 : torso, steps, out);
+  WalkHooks hooks(body, *c, drive, torso == body.root_body ? -1 : torso, steps, out);
   StepRecorder record;
   out.stats = run_rollout(worker, hooks, static_cast<int>(40.0 / timestep), drive, &record);
   mjModel* plain = mj_copyModel(nullptr, model->get());
@@ -190,25 +203,25 @@ void expect_walks(const Expect& e, double timestep) {
   EXPECT_EQ(out.replay_error, 0.0);
 }
 
-TEST(WalkController, HumanWalksThirtySteps) {
+TEST(WalkSkill, HumanWalksThirtySteps) {
   expect_walks({"human3d", "silly_walk_start.json", 0.5, 1.5}, 0.002);
 }
-TEST(WalkController, HumanWalksAtHalfTheTimestep) {
+TEST(WalkSkill, HumanWalksAtHalfTheTimestep) {
   expect_walks({"human3d", "silly_walk_start.json", 0.5, 1.5}, 0.001);
 }
-TEST(WalkController, RobotWalksThirtySteps) {
+TEST(WalkSkill, RobotWalksThirtySteps) {
   expect_walks({"robot3d", "robot_silly_walk_start.json", 0.9, 1.5}, 0.002);
 }
-TEST(WalkController, RobotWalksAtHalfTheTimestep) {
+TEST(WalkSkill, RobotWalksAtHalfTheTimestep) {
   expect_walks({"robot3d", "robot_silly_walk_start.json", 0.9, 1.5}, 0.001);
 }
 
 // Every joint but the neck has a target in each of the two states (the stance hip's two
 // are the pelvis's), plus the lift duration and four feedback gains.
-TEST(WalkController, ParametersNamedAndRanged) {
+TEST(WalkSkill, ParametersNamedAndRanged) {
   for (const auto& [name, count] : {std::pair<const char*, size_t>{"human3d", 49}, {"robot3d", 29}}) {
     const Loaded l = load(name);
-    const auto specs = WalkController::parameter_specs(l.body);
+    const auto specs = specs_of(l, l.body);
     EXPECT_EQ(specs.size(), count) << name;
     std::set<std::string> names;
     for (const ParamSpec& s : specs) {
@@ -224,7 +237,8 @@ TEST(WalkController, ParametersNamedAndRanged) {
     for (const std::string& n : names) EXPECT_EQ(n.find("neck"), std::string::npos) << n;
     EXPECT_EQ(names.count("lift.stance.hip"), 0u) << "the stance hip holds the pelvis";
   }
-  const auto human = WalkController::parameter_specs(load("human3d").body);
+  const Loaded h = load("human3d");
+  const auto human = specs_of(h, h.body);
   std::set<std::string> names;
   for (const ParamSpec& s : human) names.insert(s.name);
   for (const char* n : {"lift.torso.waist", "lift.torso.waist_roll", "lift.swing_side.shoulder",
@@ -235,15 +249,14 @@ TEST(WalkController, ParametersNamedAndRanged) {
 
 // The start state: at rest, the stance (right) sole on the floor, the swing foot above it,
 // the root upright at its pelvis target.
-TEST(WalkController, StartsStaticInTheFirstStatesPose) {
+TEST(WalkSkill, StartsStaticInTheFirstStatesPose) {
   for (const auto& [name, params] : {std::pair<const char*, const char*>{"human3d", "silly_walk_start.json"},
                                      {"robot3d", "robot_silly_walk_start.json"}}) {
     const Loaded l = load(name);
-    WalkController c(l.body, WalkControllerConfig{});
-    c.set_parameters(read_values(l.body, kRoot + "/tasks/" + params));
+    const std::unique_ptr<Controller> c = make(l, l.body, read_values(l, l.body, kRoot + "/tasks/" + params));
     SimWorker w(l.model);
     w.reset();
-    ASSERT_TRUE(c.start_state(w.model(), w.data()));
+    ASSERT_TRUE(c->start_state(w.model(), w.data()));
     mjData* d = w.data();
     const mjModel* m = w.model();
     mj_forward(m, d);
@@ -258,36 +271,46 @@ TEST(WalkController, StartsStaticInTheFirstStatesPose) {
     }
     EXPECT_NEAR(lowest[1], 0.0, 1e-9) << name;
     EXPECT_GT(lowest[0], 0.02) << name << ": the swing foot is lifted";
-    const double pitch = read_values(l.body, kRoot + "/tasks/" + params)[0];
+    const double pitch = read_values(l, l.body, kRoot + "/tasks/" + params)[0];
     EXPECT_NEAR(tilt_deg(d, l.body.root_body), std::fabs(pitch) * 180 / M_PI, 0.5) << name;
   }
 }
 
-TEST(WalkController, ConfigReadStrictly) {
-  const WalkControllerType type;
-  const toml::table ok = toml::parse("type = \"walk3d\"\nroot_kp = 2000\nstance_support = 0.5\n");
-  const auto config = type.read_config(TomlReader("walk.toml", ok, "controller"));
-  const auto& c = dynamic_cast<const WalkControllerConfig&>(*config);
-  EXPECT_EQ(c.root_kp, 2000);
-  EXPECT_EQ(c.stance_support, 0.5);
-  const toml::table bad = toml::parse("type = \"walk3d\"\nroot_gain = 2000\n");
+// A task's [controller] table overrides the walk modules' number settings: a stance
+// support of 0 lets the bird's stance knee give way under it.
+TEST(WalkSkill, ATaskOverridesTheModulesSettings) {
+  const std::string task = kRoot + "/tasks/robot_silly_walk.toml";
+  const std::string text = [&] {
+    std::ifstream in(task);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }();
+  const std::string key = "skill = \"../skills/robot_walk3d.toml\"\n";
+  ASSERT_NE(text.find(key), std::string::npos);
+  std::string weak = text;
+  weak.replace(weak.find(key), key.size(), "skill = \"" + kRoot + "/skills/robot_walk3d.toml\"\nsupport = { support = 0.0 }\n");
+  for (const char* k : {"character = \"", "m0 = \"", "base = \""}) weak.insert(weak.find(k) + std::string(k).size(), kRoot + "/tasks/");
+  const std::string file = testing::TempDir() + "robot_walk_without_support.toml";
+  std::ofstream(file) << weak;
+  const Task t = load_task(file);
+  const auto& config = dynamic_cast<const SkillConfig&>(*t.controller_config);
+  EXPECT_EQ(config.skill->modules[static_cast<size_t>(config.skill->module_index("support"))].settings.at("support").number, 0.0);
+  const TaskEvaluator with(load_task(task)), without(t);
+  const std::vector<double> m0 = with.load_parameters(load_task(task).m0).values();
+  auto w1 = with.make_worker();
+  auto w2 = without.make_worker();
+  EXPECT_EQ(with.evaluate(m0, *w1).constraint, 0.0);
+  EXPECT_GT(without.evaluate(m0, *w2).constraint, 0.0) << "the walk does not hold up without the stance support";
+  // An unknown setting is refused with the task file's name.
+  std::string bad = weak;
+  bad.replace(bad.find("support = { support = 0.0 }"), 27, "support = { strength = 1.0 }");
+  std::ofstream(file) << bad;
   try {
-    type.read_config(TomlReader("walk.toml", bad, "controller"));
-    FAIL() << "unknown key accepted";
+    load_task(file);
+    FAIL() << "an unknown setting accepted";
   } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("walk.toml: controller.root_gain: expected no such key"), std::string::npos)
-        << e.what();
-  }
-}
-
-TEST(WalkController, RefusesAPlanarCharacter) {
-  const Loaded l = load("human2d");
-  try {
-    WalkControllerType().check(l.body, "walk.toml");
-    FAIL() << "a planar character accepted";
-  } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("walk.toml: controller.type: expected a character with a free root"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("controller.support.strength: expected a setting of the \"stance_support\" module"), std::string::npos)
         << e.what();
   }
 }
