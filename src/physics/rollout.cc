@@ -166,6 +166,7 @@ RolloutStats rollout(SimWorker& worker, StepHooks& hooks, int max_steps,
       stats.unstable = true;
       break;
     }
+    hooks.stepped(m, d);
   }
   // A MuJoCo error leaves mjData half-updated; never reuse it as is.
   if (stats.unstable) mj_resetData(m, d);

@@ -35,6 +35,13 @@ class StepHooks {
   virtual void control(mjModel* m, mjData* d) = 0;
   // Called after control(), before integration. Return true to stop before this step.
   virtual bool observe(const mjModel* m, const mjData* d) = 0;
+  // Called after each step is integrated (its last integration), with mjData as a plain
+  // mj_step leaves it: the contacts and forces of the state before the step, the velocity
+  // after it. Not called for a step that blew up. For measures that a replay of the record
+  // would take the same way (task/foot_slip.h).
+  virtual void stepped(const mjModel* m, const mjData* d) {
+    (void)m, (void)d;
+  }
 };
 
 // Everything needed to replay a rollout exactly, and what to check it with.

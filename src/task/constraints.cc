@@ -35,6 +35,10 @@ ConstraintTerm half_timestep_term(const Task& task, const MotionSummary& coarse,
   return term;
 }
 
+double foot_slip_excess(const TaskConstraints& c, const MotionSummary& motion) {
+  return c.foot_slip ? std::max(0.0, motion.foot_slip - c.max_foot_slip) : 0.0;
+}
+
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
   if (task.walk.enabled) return walk_constraints(task, motion);
   const TaskConstraints& c = task.constraints;
@@ -107,6 +111,7 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
   if (c.pitch) {
     quadratic("pitch", std::max(0.0, motion.max_forward_pitch - c.max_pitch));
   }
+  if (c.foot_slip) quadratic("foot_slip", foot_slip_excess(c, motion));
   return report;
 }
 

@@ -50,6 +50,9 @@ struct MotionSummary {
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
+  // m, the largest slide of a planted foot in one stance (task/foot_slip.h), measured in
+  // the rollout when the task bounds it (TaskConstraints::foot_slip); 0 otherwise.
+  double foot_slip = 0;
   // The rollout was ended once the motion could no longer meet the task
   // (EvaluationOptions::end_when_decided). A jump (ended once landed): the feet "at rest"
   // are where they were then, the rotation from standing to standing, known only at rest,
@@ -73,6 +76,10 @@ struct ConstraintReport {
 };
 
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion);
+
+// How far (m) the motion's worst stance slid beyond the task's bound (0 within it, or
+// without one): the violation of the term "foot_slip", K_c d^2, of jumps and walks alike.
+double foot_slip_excess(const TaskConstraints& c, const MotionSummary& motion);
 
 // Two simulations of one motion at different timesteps agree when the feet land within
 // this distance (m) of the same spot, at touch-down and at rest.

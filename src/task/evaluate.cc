@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "core/error.h"
 #include "core/text_file.h"
+#include "task/foot_slip.h"
 #include "task/scene_check.h"
 #include "task/support.h"
 #include "task/walk_eval.h"
@@ -317,6 +319,7 @@ class PushHooks : public StepHooks {
     inner_.control(m, d);
   }
   bool observe(const mjModel* m, const mjData* d) override { return inner_.observe(m, d); }
+  void stepped(const mjModel* m, const mjData* d) override { inner_.stepped(m, d); }
 
  private:
   StepHooks& inner_;
@@ -325,18 +328,40 @@ class PushHooks : public StepHooks {
   Evaluation& out_;
 };
 
+// A rollout's hooks that also measure its foot slip (TaskConstraints::foot_slip), step by
+// step as a replay of its record would (task/foot_slip.h); without a meter they only
+// forward.
+class MeteredHooks : public StepHooks {
+ public:
+  MeteredHooks(StepHooks& inner, FootSlipMeter* meter) : inner_(inner), meter_(meter) {}
+  void control(mjModel* m, mjData* d) override { inner_.control(m, d); }
+  bool observe(const mjModel* m, const mjData* d) override { return inner_.observe(m, d); }
+  void stepped(const mjModel* m, const mjData* d) override {
+    if (meter_ != nullptr) meter_->after_step(m, d);
+    inner_.stepped(m, d);
+  }
+
+ private:
+  StepHooks& inner_;
+  FootSlipMeter* meter_;
+};
+
 // Runs a rollout with a task's hooks (under the suite's push, if any) and fills in what
 // every kind of task reports of it: the rollout's stats, phases and failure, C, and when
 // the outcome was decided (Hooks: JumpHooks or WalkObserver).
 template <class Hooks>
 void simulate(const Task& task, const Character& body, const Controller& controller, JointDrive& drive,
               Hooks& hooks, int max_steps, SimWorker& worker, const EvaluationOptions& options, Evaluation& e) {
+  std::optional<FootSlipMeter> meter;
+  if (task.constraints.foot_slip) meter.emplace(worker.model(), foot_geom_sides(worker.model(), body));
+  MeteredHooks metered(hooks, meter ? &*meter : nullptr);
   if (options.push.time >= 0) {
-    PushHooks pushed(hooks, body, options.push, e);
+    PushHooks pushed(metered, body, options.push, e);
     e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
   } else {
-    e.stats = run_rollout(worker, hooks, max_steps, drive, options.recorder);
+    e.stats = run_rollout(worker, metered, max_steps, drive, options.recorder);
   }
+  if (meter) e.summary.foot_slip = meter->finish().largest();
   e.phases = controller.phase_times();
   if (e.stats.unstable) {
     e.failed = true;

@@ -72,6 +72,51 @@ inline constexpr int kBodyGeom = -2;
 // Per geom of `m`: 0 or 1 (the left or right feet), kBodyGeom or kSceneGeom.
 std::vector<int> foot_geom_sides(const mjModel* m, const Character& body);
 
+// The measure step by step, for a rollout that measures itself (task/evaluate.h) or a
+// replay: after_step() after each integration step, with mjData as mj_step leaves it
+// (the contacts and forces of the state before the step, the velocity after it).
+class FootSlipMeter {
+ public:
+  // `m` gives the timestep and the dofs; `geom_sides` as foot_geom_sides() gives it.
+  FootSlipMeter(const mjModel* m, std::vector<int> geom_sides, const FootSlipOptions& options = {});
+  void after_step(const mjModel* m, const mjData* d);
+  // m: the largest slide of any stance so far, the open ones included.
+  double largest_so_far() const;
+  // The measure of the steps seen, open stances closed at the last one.
+  FootSlip finish() const;
+
+ private:
+  // A material point of a foot where it last carried load: its body, its position in
+  // that body's frame, and the surface normal there.
+  struct HeldPoint {
+    int body = -1;
+    mjtNum local[3] = {0, 0, 0};
+    mjtNum normal[3] = {0, 0, 1};
+  };
+  // One side's stance being measured.
+  struct Track {
+    bool open = false;            // a stance is under way
+    bool from_start = false;      // it was under way when the record began (no impact)
+    double last_down = 0;         // s: the last step with the feet down
+    std::vector<HeldPoint> held;  // where the feet last carried load in this stance
+    double pending = 0;           // m: slid since then, over steps without a loaded point
+    double pending_speed = 0;     // m/s: the largest speed among those steps
+    double pending_time = -1;     // s: when
+    FootSlip::Stance stance;
+  };
+  // The velocity of body b's material point at p over the step: J_p(q_k) v_{k+1}.
+  static void point_velocity(const mjModel* m, const mjData* d, int b, const mjtNum* p,
+                             std::vector<mjtNum>& jac, mjtNum v[3]);
+
+  std::vector<int> geom_sides_;
+  FootSlipOptions options_;
+  double h_ = 0;
+  std::vector<mjtNum> jac_foot_, jac_other_;
+  std::array<Track, 2> tracks_;
+  std::array<std::vector<HeldPoint>, 2> loaded_;
+  FootSlip slip_;
+};
+
 // Replays `record` on `m` (a private copy of the motion's saved model: its dof_damping is
 // written) and measures both sides' feet. `geom_sides` as foot_geom_sides() gives it.
 FootSlip measure_foot_slip(mjModel* m, const StepRecorder& record, const std::vector<int>& geom_sides,

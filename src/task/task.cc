@@ -82,7 +82,7 @@ void require_object(const TomlReader& r, const Task& task, const char* key, cons
 
 void read_constraints(const TomlReader& r, Task& task) {
   r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
-          "peak_height", "rotation", "pitch", "half_timestep"});
+          "peak_height", "rotation", "pitch", "half_timestep", "foot_slip"});
   TaskConstraints& c = task.constraints;
   c.weight = r.number("weight", 1e-6, 1e9);
   c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
@@ -155,6 +155,12 @@ void read_constraints(const TomlReader& r, Task& task) {
     s.only({"max"});
     c.pitch = true;
     c.max_pitch = s.number("max", 0.01, 3.14);
+  }
+  if (auto t = r.table("foot_slip", false)) {
+    TomlReader s = r.sub("foot_slip", *t);
+    s.only({"per_stance"});
+    c.foot_slip = true;
+    c.max_foot_slip = s.number("per_stance", 0, 1);
   }
   c.half_timestep = r.boolean("half_timestep", false);
 }

@@ -80,6 +80,11 @@ struct TaskConstraints {
   // `max_pitch` throughout the motion (the bird robot's long jump).
   bool pitch = false;
   double max_pitch = 0;
+  // A planted foot slides at most `max_foot_slip` (m) in any one stance, measured in the
+  // rollout as task/foot_slip.h measures a replay (docs/reference/foot-slip.md): the
+  // largest stance's slide of either side, every stance of the motion counted.
+  bool foot_slip = false;
+  double max_foot_slip = 0.02;
 };
 
 struct TaskSimulation {

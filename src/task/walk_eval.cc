@@ -122,6 +122,7 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
     walk.start_heading = raw;
     state_ = controller_.phase();
     first_ = false;
+    for (size_t f = 0; f < 2; ++f) footprint_[f] = {d->xpos[3 * body_.feet[f]], d->xpos[3 * body_.feet[f] + 1]};
   } else {
     heading_ += std::remainder(raw - last_raw_heading_, 2 * M_PI);
   }
@@ -146,7 +147,7 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
         // where the other foot landed: a foot that slides or shuffles back after landing
         // would let short or backward steps count as long ones.)
         const double* p = d->xpos + 3 * body_.feet[i];
-        const double* o = d->xpos + 3 * body_.feet[1 - i];
+        const double* o = w.from_footprint ? footprint_[1 - i].data() : d->xpos + 3 * body_.feet[1 - i];
         const double dx = p[0] - o[0], dy = p[1] - o[1];
         WalkStep step;
         step.leg = f;
@@ -169,6 +170,7 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
         }
       }
       last_leg_ = f;
+      footprint_[i] = {d->xpos[3 * body_.feet[i]], d->xpos[3 * body_.feet[i] + 1]};
     }
     ground_[i] = now[i];
   }

@@ -77,6 +77,7 @@ class WalkObserver : public StepHooks {
   long index_ = 0;                       // simulation steps observed
   long decided_ = -1;                    // index_ when a step first broke the rules, or -1
   std::array<bool, 2> ground_{true, true};  // each foot on something not the character
+  std::array<std::array<double, 2>, 2> footprint_{};  // m: each foot's body origin (x, y) at its last touch-down
   std::array<double, 2> lifted_{0, 0};   // s (index x timestep), when each foot last left it
   int last_leg_ = -1;                    // the foot that made the last step
   int strikes_ = 0;                      // strike states ended by a touch-down

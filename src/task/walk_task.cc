@@ -25,7 +25,7 @@ void read_range(const TomlReader& r, const char* key, double lo, double hi, doub
 }  // namespace
 
 void read_walk(const TomlReader& r, TaskWalk& w) {
-  r.only({"steps", "settle_steps", "forward", "lateral", "max_tilt", "max_turn", "max_flight", "max_time"});
+  r.only({"steps", "settle_steps", "forward", "lateral", "max_tilt", "max_turn", "max_flight", "max_time", "step_from"});
   w.enabled = true;
   w.steps = static_cast<int>(r.integer("steps", 1, 1000, w.steps));
   w.settle_steps = static_cast<int>(r.integer("settle_steps", 0, w.steps - 1, std::min(w.settle_steps, w.steps - 1)));
@@ -35,6 +35,13 @@ void read_walk(const TomlReader& r, TaskWalk& w) {
   w.max_turn_deg = r.number("max_turn", 0, 360, w.max_turn_deg);
   w.max_flight = r.number("max_flight", 0, 10, w.max_flight);
   w.max_time = r.number("max_time", 1, 600, w.max_time);
+  if (r.has("step_from")) {
+    const std::string from = r.string("step_from");
+    if (from != "foot" && from != "footprint") {
+      r.fail("step_from", "expected \"foot\" (the other foot where it is) or \"footprint\" (where it last touched down), got \"" + from + "\"");
+    }
+    w.from_footprint = from == "footprint";
+  }
 }
 
 double largest_turn(const WalkSummary& walk) {
@@ -76,6 +83,10 @@ ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion)
   add("step_lateral", std::sqrt(lateral), c.weight * lateral);
   add("upright", std::sqrt(tilt), c.weight * tilt);
   add("turn", turn, c.weight * turn * turn);
+  if (c.foot_slip) {
+    const double d = foot_slip_excess(c, motion);
+    add("foot_slip", d, c.weight * d * d);
+  }
   // A walk ended at the step that first broke the rules (MotionSummary::ended_decided):
   // its evaluated steps so far stand for all of them, as a walk that has settled into its
   // gait repeats its steps, so their excesses count (evaluated steps) / (steps so far)

@@ -13,6 +13,7 @@
 //   max_turn = 30.0             # degrees, heading change from the start, every touch-down
 //   max_flight = 0.05           # s, longest time both feet may be off the ground at once
 //   max_time = 40.0             # s; a walk that has not taken `steps` steps by then fell
+//   step_from = "foot"          # or "footprint": where a step is measured from (below)
 //
 // A step is a foot landing after at least kMinAirTime (0.05 s) in the air, the feet
 // alternating: a foot that lands again before the other one has is re-landing (counted,
@@ -24,7 +25,10 @@
 // the robot's toe joint) minus where the other foot is at that moment, in the heading
 // frame at the touch-down: forward along the root's forward axis turned onto the ground,
 // lateral to its left. (Measured from where the other foot landed instead, a foot that
-// slid or shuffled back after landing let backward steps count as long ones.) The rollout
+// slid or shuffled back after landing let backward steps count as long ones.) With
+// step_from = "footprint" a step is measured from the other foot's body origin at its
+// last touch-down instead (its start position before its first), footprint to
+// footprint, which a foot-slip bound keeps honest. The rollout
 // ends when the walk has taken `steps` steps and the controller has ended as many strike
 // states (for a walk whose feet land only when its swings end, the same touch-down).
 //
@@ -66,6 +70,11 @@ struct TaskWalk {
   double max_turn_deg = 30;
   double max_flight = 0.05;  // s, both feet off the ground at once
   double max_time = 40;  // s
+  // Where a step is measured from: the other foot where it is at the touch-down ("foot",
+  // the default), or where it last touched down ("footprint": footprint to footprint, as
+  // a person measures a walk's steps; with a foot-slip bound, [constraints] foot_slip, a
+  // foot cannot shuffle back after landing to lengthen the next step).
+  bool from_footprint = false;
 };
 
 // Parses a [walk] table into `walk` (enabled). Throws UserError "FILE: walk.KEY: expected ...".

@@ -10,10 +10,13 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "physics/model.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -205,6 +208,68 @@ TEST(FootSlip, ACommittedInputMotionHasStancesOnBothSides) {
   EXPECT_EQ(j["left"]["stances"], 2);
   EXPECT_EQ(j["right"]["stance_slides"].size(), 2u);
   EXPECT_DOUBLE_EQ(j["largest_per_stance"].get<double>(), slip.largest());
+}
+
+// The task's bound (TaskConstraints::foot_slip) measures the rollout step by step as the
+// replay measures its record: the same largest stance, to the last bit, and a term
+// "foot_slip" of K_c d^2 for the excess d only when the bound is broken.
+TEST(FootSlip, ATaskBoundMeasuresTheRolloutAsTheReplayDoes) {
+  auto rollout = [](const std::string& name, const std::string& bound, StepRecorder* record) {
+    const auto file = test_files::task_variant("jump_high", name, {}, {{"constraints", "foot_slip = { per_stance = " + bound + " }"}});
+    const TaskEvaluator ev(load_task(file.string()));
+    EXPECT_TRUE(ev.task().constraints.foot_slip);
+    EvaluationOptions options;
+    options.samples_per_phase = 0;
+    options.recorder = record;
+    const auto worker = ev.make_worker();
+    Evaluation e = ev.evaluate(ev.load_parameters(ev.task().m0).values(), *worker, options);
+    double replayed = -1;
+    if (record != nullptr) {
+      mjModel* m = mj_copyModel(nullptr, ev.model().get());
+      replayed = measure_foot_slip(m, *record, ev.body()).largest();
+      mj_deleteModel(m);
+    }
+    return std::make_pair(e, replayed);
+  };
+  StepRecorder record;
+  const auto [loose, replayed] = rollout("slip_loose", "0.05", &record);
+  ASSERT_FALSE(loose.fell);
+  EXPECT_GT(loose.summary.foot_slip, 0.002);
+  EXPECT_EQ(loose.summary.foot_slip, replayed);
+  EXPECT_EQ(loose.constraint, 0);
+  const auto term = [](const Evaluation& e) {
+    for (const ConstraintTerm& t : e.report.terms)
+      if (t.name == "foot_slip") return t;
+    ADD_FAILURE() << "no foot_slip term";
+    return ConstraintTerm{};
+  };
+  EXPECT_EQ(term(loose).penalty, 0);
+  // A bound 1 mm below what the input motion slides: broken by 1 mm.
+  std::ostringstream tight;
+  tight.precision(17);
+  tight << loose.summary.foot_slip - 0.001;
+  const auto [broken, unused] = rollout("slip_tight", tight.str(), nullptr);
+  (void)unused;
+  EXPECT_EQ(broken.summary.foot_slip, loose.summary.foot_slip);  // the same rollout
+  EXPECT_NEAR(term(broken).violation, 0.001, 1e-12);
+  EXPECT_NEAR(broken.constraint, 5000.0 * 1e-6, 1e-9);
+}
+
+TEST(FootSlip, ATaskBoundOutOfRangeOrWithAnUnknownKeyIsNamed) {
+  const auto bad = [](const std::string& name, const std::string& line) {
+    const auto file = test_files::task_variant("jump_high", name, {}, {{"constraints", line}});
+    try {
+      load_task(file.string());
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(bad("slip_negative", "foot_slip = { per_stance = -0.01 }").find("constraints.foot_slip.per_stance: expected"),
+            std::string::npos)
+      << bad("slip_negative", "foot_slip = { per_stance = -0.01 }");
+  EXPECT_NE(bad("slip_unknown", "foot_slip = { largest = 0.02 }").find("constraints.foot_slip"), std::string::npos)
+      << bad("slip_unknown", "foot_slip = { largest = 0.02 }");
 }
 
 }  // namespace

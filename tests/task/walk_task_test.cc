@@ -305,6 +305,50 @@ TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
   EXPECT_FALSE(a.violations.empty());
 }
 
+// step_from = "footprint": a step from where the other foot last touched down. The
+// committed input walks' steps are then the audit's footprint-to-footprint steps, longer
+// than from where the other foot is (it rolls and slides forward while down), and still
+// within their tasks' ranges. The human walk that slides its feet back after landing
+// (above) breaks the footprint rule too, its touch-downs found from the contacts, and a
+// foot-slip bound ([constraints] foot_slip) adds what it slides: decimetres a stance.
+TEST(WalkEvaluation, FromFootprintsTheStepsAreTheAuditsAndASlidingFootBreaksTheSlipBound) {
+  for (const std::string name : {"silly_walk", "robot_silly_walk"}) {
+    Task task = load_task(kTasks + name + ".toml");
+    task.walk.from_footprint = true;
+    const TaskEvaluator ev(task);
+    const ParameterSet p = ev.load_parameters(ev.task().m0);
+    const Evaluation e = evaluate_once(ev, p);
+    ASSERT_FALSE(e.fell) << name << ": " << e.summary.fall_reason;
+    EXPECT_EQ(e.constraint, 0) << name;
+    const WalkAudit a = audit_once(ev, p);
+    const auto& steps = e.summary.walk.steps;
+    ASSERT_EQ(a.steps.size(), steps.size());
+    for (size_t k = 0; k < steps.size(); ++k) {
+      EXPECT_NEAR(steps[k].forward, a.steps[k].footprint_forward, 0.01) << name << " step " << k + 1;
+      EXPECT_NEAR(steps[k].lateral, a.steps[k].footprint_lateral, 0.01) << name << " step " << k + 1;
+    }
+    for (size_t k = 10; k < steps.size(); ++k) EXPECT_GT(steps[k].forward, a.steps[k].forward + 0.03) << name << " step " << k + 1;
+  }
+  Task task = task_at_2ms("silly_walk.toml");
+  task.walk.from_footprint = true;
+  const TaskEvaluator loose(task);
+  const ParameterSet p = test_walk(loose, "human_walk_slides_back.json");
+  const Evaluation e = evaluate_once(loose, p);
+  ASSERT_FALSE(e.fell) << e.summary.fall_reason;
+  // Its touch-downs, found from the contacts, are still steps backward.
+  EXPECT_GT(e.constraint, 0);
+  task.constraints.foot_slip = true;
+  task.constraints.max_foot_slip = 0.02;
+  const TaskEvaluator bounded(task);
+  const Evaluation f = evaluate_once(bounded, p);
+  EXPECT_GT(f.summary.foot_slip, 0.1);
+  double slip_penalty = -1;
+  for (const auto& term : f.report.terms)
+    if (term.name == "foot_slip") slip_penalty = term.penalty;
+  EXPECT_NEAR(slip_penalty, 5000 * std::pow(f.summary.foot_slip - 0.02, 2), 1e-9);
+  EXPECT_GT(f.constraint, 0);
+}
+
 // Steps are found from the feet's contacts, as the audit finds them. A robot walk that a
 // run found while steps were taken from the controller's strike states shuffles: now and
 // then it sets its swing foot down beside or behind the other one while its lift state
