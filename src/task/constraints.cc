@@ -39,6 +39,11 @@ double foot_slip_excess(const TaskConstraints& c, const MotionSummary& motion) {
   return c.foot_slip ? std::max(0.0, motion.foot_slip - c.max_foot_slip) : 0.0;
 }
 
+double foot_slip_margin(const TaskConstraints& c, const MotionSummary& motion) {
+  if (!c.foot_slip || !(c.max_foot_slip > 0)) return INFINITY;
+  return 0.1 * (1 - motion.foot_slip / c.max_foot_slip);
+}
+
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion) {
   if (task.walk.enabled) return walk_constraints(task, motion);
   const TaskConstraints& c = task.constraints;
@@ -156,6 +161,7 @@ double constraint_margin(const Task& task, const MotionSummary& motion) {
     if (c.min_length) margin = std::min(margin, x - c.min_length_value);
   }
   if (c.clearance) margin = std::min(margin, motion.min_clearance - c.min_clearance);
+  margin = std::min(margin, foot_slip_margin(c, motion));
   if (c.peak_height) margin = std::min(margin, motion.peak_com_z - peak_height_required(c, motion));
   if (c.rotation) {
     const double miss = std::fabs(motion.rotation_total - 2 * M_PI * c.rotation_turns);

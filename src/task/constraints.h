@@ -80,6 +80,10 @@ ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& mot
 // How far (m) the motion's worst stance slid beyond the task's bound (0 within it, or
 // without one): the violation of the term "foot_slip", K_c d^2, of jumps and walks alike.
 double foot_slip_excess(const TaskConstraints& c, const MotionSummary& motion);
+// Its share of constraint_margin(): 0.1 m times the share of the bound left unused (a
+// stance that slides half the bound counts as 5 cm of slack, as a landing 5 cm inside its
+// box does); infinite without a bound.
+double foot_slip_margin(const TaskConstraints& c, const MotionSummary& motion);
 
 // Two simulations of one motion at different timesteps agree when the feet land within
 // this distance (m) of the same spot, at touch-down and at rest.
@@ -107,7 +111,8 @@ double touchdown_bound(const Task& task, const MotionSummary& motion);
 
 // How far inside the allowed region the motion is: the smallest slack (m) over the
 // task's geometric constraints (landing box, box edges, clearance, length, peak height;
-// rotation slack counts 0.2 m per rad), negative when violated. Used only to prefer
+// rotation slack counts 0.2 m per rad; a foot-slip bound as foot_slip_margin() says),
+// negative when violated. Used only to prefer
 // robust input motions when seeding (`diverse seed-motion`), never inside C.
 double constraint_margin(const Task& task, const MotionSummary& motion);
 

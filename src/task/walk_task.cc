@@ -111,6 +111,7 @@ double walk_margin(const Task& task, const MotionSummary& motion) {
                        w.max_tilt_deg * kDeg - s.tilt});
   }
   margin = std::min(margin, w.max_turn_deg * kDeg - largest_turn(motion.walk));
+  margin = std::min(margin, foot_slip_margin(task.constraints, motion));
   return std::isfinite(margin) ? margin : -1;
 }
 

@@ -244,6 +244,13 @@ TEST(FootSlip, ATaskBoundMeasuresTheRolloutAsTheReplayDoes) {
     return ConstraintTerm{};
   };
   EXPECT_EQ(term(loose).penalty, 0);
+  // The slack of the bound, for the input-motion search: the share left unused, as 10 cm.
+  TaskConstraints bound;
+  bound.foot_slip = true;
+  bound.max_foot_slip = 0.05;
+  EXPECT_NEAR(foot_slip_margin(bound, loose.summary), 0.1 * (1 - loose.summary.foot_slip / 0.05), 1e-15);
+  bound.foot_slip = false;
+  EXPECT_EQ(foot_slip_margin(bound, loose.summary), INFINITY);
   // A bound 1 mm below what the input motion slides: broken by 1 mm.
   std::ostringstream tight;
   tight.precision(17);
