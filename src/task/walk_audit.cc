@@ -122,7 +122,8 @@ WalkAudit audit_walk(const mjModel* model, const StepRecorder& record, const Cha
         if (f == last_leg) {
           ++a.relandings;
         } else {
-          const double* from = d->xpos + 3 * body.feet[1 - i];  // the other foot, now
+          // The other foot now, or its footprint, as the task measures steps.
+          const double* from = walk.from_footprint ? footprint[1 - i].data() : d->xpos + 3 * body.feet[1 - i];
           const double dx = p[0] - from[0], dy = p[1] - from[1];
           WalkAudit::Step step;
           step.leg = f;

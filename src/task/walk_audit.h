@@ -9,9 +9,11 @@
 // that is not the character's; a step is a foot landing after at least kMinAirTime in the
 // air, alternating feet (a foot that lands twice in a row is a stumble, not a step, and is
 // counted in `relandings`). A step's length is where the landing foot's body origin is,
-// minus where the other foot's is at that moment, in the heading frame of the root at
-// the landing (its forward axis turned onto the ground, lateral to its left); the step
-// from footprint to footprint is reported beside it (Step::footprint_forward). Tilt is the
+// minus where the other foot's is at that moment (or, for a task that measures steps
+// from footprints, TaskWalk::from_footprint, where it last touched down), in the heading
+// frame of the root at the landing (its forward axis turned onto the ground, lateral to
+// its left); the step from footprint to footprint is reported beside it
+// (Step::footprint_forward). Tilt is the
 // angle of the root's and the torso's standing "up" from world vertical (the torso: the
 // body of the deepest centre waist hinge), the largest since the previous step. A fall is any contact of a non-foot geom of the character with
 // something that is not the character; a walk never has both feet off the ground for
@@ -39,7 +41,7 @@ struct WalkAudit {
     int leg = 0;          // 0 left, 1 right
     int sim_step = 0;     // index into the record
     double time = 0;      // s
-    double forward = 0, lateral = 0;  // m
+    double forward = 0, lateral = 0;  // m, by the task's rule
     // m: footprint to footprint, as a person measures a step: where the landing foot's
     // body origin is, minus where the other foot's was when it last touched down (its
     // footprint), in the same heading frame. Differs from forward/lateral by how far the

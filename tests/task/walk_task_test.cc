@@ -281,7 +281,9 @@ TEST(WalkEvaluation, AHopIsAFall) {
 // Between the feet at each touch-down, found from the feet's contacts, most of its steps
 // go backward, and it breaks the task.
 TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
-  const TaskEvaluator ev(task_at_2ms("silly_walk.toml"));
+  Task task = task_at_2ms("silly_walk.toml");
+  task.walk.from_footprint = false;  // the rule this test is about (the task's is footprints)
+  const TaskEvaluator ev(task);
   const ParameterSet p = test_walk(ev, "human_walk_slides_back.json");
   const Evaluation e = evaluate_once(ev, p);
   ASSERT_FALSE(e.fell) << e.summary.fall_reason;
@@ -314,6 +316,9 @@ TEST(WalkEvaluation, AStepIsMeasuredFromWhereTheOtherFootIsNow) {
 TEST(WalkEvaluation, FromFootprintsTheStepsAreTheAuditsAndASlidingFootBreaksTheSlipBound) {
   for (const std::string name : {"silly_walk", "robot_silly_walk"}) {
     Task task = load_task(kTasks + name + ".toml");
+    ASSERT_TRUE(task.walk.from_footprint) << name;
+    task.walk.from_footprint = false;
+    const Evaluation from_foot = evaluate_once(TaskEvaluator(task), TaskEvaluator(task).load_parameters(task.m0));
     task.walk.from_footprint = true;
     const TaskEvaluator ev(task);
     const ParameterSet p = ev.load_parameters(ev.task().m0);
@@ -327,7 +332,9 @@ TEST(WalkEvaluation, FromFootprintsTheStepsAreTheAuditsAndASlidingFootBreaksTheS
       EXPECT_NEAR(steps[k].forward, a.steps[k].footprint_forward, 0.01) << name << " step " << k + 1;
       EXPECT_NEAR(steps[k].lateral, a.steps[k].footprint_lateral, 0.01) << name << " step " << k + 1;
     }
-    for (size_t k = 10; k < steps.size(); ++k) EXPECT_GT(steps[k].forward, a.steps[k].forward + 0.03) << name << " step " << k + 1;
+    ASSERT_EQ(from_foot.summary.walk.steps.size(), steps.size());
+    for (size_t k = 10; k < steps.size(); ++k)
+      EXPECT_GT(steps[k].forward, from_foot.summary.walk.steps[k].forward + 0.03) << name << " step " << k + 1;
   }
   Task task = task_at_2ms("silly_walk.toml");
   task.walk.from_footprint = true;
@@ -435,8 +442,9 @@ TEST(WalkHalfTimestep, InputWalksHoldAtHalfTheStep) {
 
     // Ended there (the optimizer's rollouts): the walk stops at that step, and its one
     // evaluated step stands for all of them. These walks repeat their strides, so the
-    // extrapolated C is within 15 % of the whole walk's (the human's 0.5 %, the robot's 10 %:
-    // its left and right steps differ), from about a third of the steps.
+    // extrapolated C is within 25 % of the whole walk's, from about a third of the steps:
+    // the human's 0.1 %, the robot's 23 % (its left and right steps differ; 10 % with steps
+    // measured from the other foot where it is rather than from its footprint).
     EvaluationOptions ended = checked;
     ended.end_when_decided = true;
     const Evaluation x = narrow.evaluate(m0.values(), *narrow.make_worker(), ended);
@@ -446,7 +454,7 @@ TEST(WalkHalfTimestep, InputWalksHoldAtHalfTheStep) {
     EXPECT_LT(x.stats.steps, n.stats.steps / 2);
     std::printf("%s: C %.0f walked to the end, %.0f ended at its first evaluated step\n", name, n.constraint,
                 x.constraint);
-    EXPECT_NEAR(x.constraint, n.constraint, 0.15 * n.constraint);
+    EXPECT_NEAR(x.constraint, n.constraint, 0.25 * n.constraint);
     const auto extra = std::find_if(x.report.terms.begin(), x.report.terms.end(),
                                     [](const ConstraintTerm& t) { return t.name == "ended_decided"; });
     ASSERT_NE(extra, x.report.terms.end());
