@@ -321,12 +321,14 @@ SkillDuration read_duration(const TomlReader& r, const toml::table& phase) {
 }
 
 // A module setting's number: in range for its name. Gains, forces, times and the lean are
-// not negative; stand_after is -1 (never) or more; offsets and gains on a velocity take any
-// finite value.
+// not negative; stand_after is -1 (never) or more; a stand-up takes 50 ms or more (the
+// stance module divides by its duration); offsets and gains on a velocity take any finite
+// value.
 void check_setting(const TomlReader& r, const std::string& key, double v) {
   double lo = 0, hi = 1e9;
   if (key.rfind("offset", 0) == 0 || key.rfind("velocity_gain", 0) == 0 || key == "speed") lo = -1e9;
   if (key == "stand_after") lo = -1;
+  if (key == "stand_duration") lo = 0.05;
   if (key == "at_touchdown" || key == "push" || key == "take_footing") hi = 1;
   if (key == "turn") hi = 8 * M_PI;
   if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + num(lo) + ", " + num(hi) + "], got " + num(v));

@@ -1,11 +1,11 @@
-// "jump2d" with crouch_lean (control/jump_controller.h): in the crouch the balance servo
-// leads the COM along a lean instead of holding it over the feet. On jump_forward's input
-// motion (crouch_lean = 0.2): pushed by 0.3 m/s forward or backward at four moments of
+// The crouch that leans in (skills/jump_forward.toml: the crouch's balance module `lean`,
+// control/module_balance.h, with lean = 0.2): in the crouch the balance servo leads the COM
+// along a lean instead of holding it over the feet. On jump_forward's input motion: pushed by 0.3 m/s forward or backward at four moments of
 // its crouch, it still lands in its box and stands in 6 of the eight rollouts (measured:
 // the forward pushes but the latest, which lands 4 cm past the box, and the backward
 // ones but the earliest, which lands short and falls), where the input
 // motion found before it without the lean (tests/control/data/jump_forward.no_lean.m0.json,
-// under the task without the key) holds none, and its take-off speed stays nearer its own
+// under the task with lean = 0, the COM held over the feet) holds none, and its take-off speed stays nearer its own
 // unpushed one. Bad values are refused.
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "support/task_errors.h"
-#include "support/jump2d_variant.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -77,10 +77,10 @@ Pushed push_the_crouch(const std::string& task_file, const std::string& paramete
 
 TEST(CrouchLean, APushedCrouchComesBackOntoItsPath) {
   const std::string source = DIVERSE_SOURCE_DIR;
-  std::printf("with crouch_lean = 0.2:\n");
+  std::printf("with lean = 0.2:\n");
   const Pushed lean = push_the_crouch(source + "/tasks/jump_forward.toml", source + "/tasks/jump_forward.m0.json");
   const std::string without =
-      test_files::jump2d_variant("jump_forward", "crouch_lean_off", {"crouch_lean ="}, {}).string();
+      test_files::task_variant("jump_forward", "crouch_lean_off", {}, {{"controller", "lean = { lean = 0.0 }"}}).string();
   std::printf("without it (the input motion found without it):\n");
   const Pushed held_over_feet =
       push_the_crouch(without, source + "/tests/control/data/jump_forward.no_lean.m0.json");
@@ -91,11 +91,11 @@ TEST(CrouchLean, APushedCrouchComesBackOntoItsPath) {
 
 TEST(CrouchLean, BadValuesAreRefused) {
   auto refused = [](const std::string& name, const std::string& line, const std::string& expected) {
-    test_files::expect_task_refused(
-        test_files::jump2d_variant("jump_forward", name, {"crouch_lean ="}, {{"controller", line}}).string(), expected);
+    test_files::expect_task_refused(test_files::task_variant("jump_forward", name, {}, {{"controller", line}}).string(),
+                                    expected);
   };
-  refused("lean_far", "crouch_lean = 2", "controller.crouch_lean: expected a number in");
-  refused("lean_text", "crouch_lean = \"far\"", "controller.crouch_lean: expected a number");
+  refused("lean_back", "lean = { lean = -0.2 }", "controller.lean.lean: expected a number in [0, ");
+  refused("lean_text", "lean = { lean = \"far\" }", "controller.lean.lean: expected a number");
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
-// "jump2d" with open_turn (control/jump_controller.h): a flip opens when the body, opened
+// Spotting the landing (skills/backflip.toml: the rise ends on `spotted`, the `spotting`
+// module with turn = 5.1, control/module_spotting.h): a flip opens when the body, opened
 // now, would have turned as far as asked by touch-down, instead of after a fixed rotation
 // since take-off. On the backflip's input motion and 32 of its perturbations (sigma 0.02,
 // the input-motion check's draws): the perturbed flips touch down at root pitches much
 // nearer each other, and more of them meet the task, than the same parameters opened by
-// the rotation since take-off (open_rotation). Bad values are refused.
+// the rotation since take-off (the rise ending on `turned`, angle = 3.3:
+// tests/task/data/backflip_open_rotation.skill.toml with the backflip's balance servo).
+// Bad values are refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +15,8 @@
 
 #include "core/error.h"
 #include "support/task_errors.h"
-#include "support/jump2d_variant.h"
+#include "support/skill_variant.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
 #include "task/task.h"
@@ -22,9 +26,16 @@ namespace {
 
 const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
-// backflip.toml with its open_turn line replaced by `lines`.
+// backflip.toml with `lines` at the top of its [controller] table.
 std::string variant(const std::string& name, const std::string& lines) {
-  return test_files::jump2d_variant("backflip", "flip_opening_" + name, {"open_turn ="}, {{"controller", lines}})
+  return test_files::task_variant("backflip", "flip_opening_" + name, {}, {{"controller", lines}}).string();
+}
+
+// The backflip opened after 3.3 rad of root rotation since take-off, with its servo.
+std::string clocked_task() {
+  return test_files::task_variant("backflip", "flip_opening_rotation", {"skill ="},
+                                  {{"controller", test_files::skill_line("tests/task/data/backflip_open_rotation.skill.toml") +
+                                                      "\nbalance = { kp = 4000.0, kd = 800.0, max_force = 800.0 }"}})
       .string();
 }
 
@@ -61,14 +72,14 @@ Landings land(const Task& task, const std::vector<Eigen::VectorXd>& xs) {
 
 TEST(FlipOpening, SpotsTheLanding) {
   const Task spotted = load_task(kTasks + "backflip.toml");
-  const Task clocked = load_task(variant("rotation", "open_rotation = 3.3"));
+  const Task clocked = load_task(clocked_task());
   const TaskEvaluator ev(spotted);
   const ParameterSet m0 = ev.load_parameters(spotted.m0);
   const std::vector<Eigen::VectorXd> xs = perturb(m0.normalized(), 0.02, 32, robustness_seed(spotted, 0.02));
   const Landings a = land(spotted, xs), b = land(clocked, xs);
   ASSERT_EQ(a.pitch.size(), xs.size());
   ASSERT_EQ(b.pitch.size(), xs.size());
-  std::printf("touch-down pitch spread (middle 80 %%): open_turn %.3f rad (%d of 32 meet the task), open_rotation %.3f rad (%d)\n",
+  std::printf("touch-down pitch spread (middle 80 %%): spotted %.3f rad (%d of 32 meet the task), turned %.3f rad (%d)\n",
               a.spread(), a.met, b.spread(), b.met);
   EXPECT_LT(a.spread(), 0.6 * b.spread());
   EXPECT_GE(a.met, 16);
@@ -79,9 +90,9 @@ TEST(FlipOpening, BadValuesAreRefused) {
   auto refused = [](const std::string& lines, const std::string& expected) {
     test_files::expect_task_refused(variant("bad", lines), expected);
   };
-  refused("open_turn = -1", "controller.open_turn: expected a number in");
-  refused("open_turn = 20", "controller.open_turn: expected a number in");
-  refused("open_turn = \"late\"", "controller.open_turn");
+  refused("spotting = { turn = -1 }", "controller.spotting.turn: expected a number in [0, ");
+  refused("spotting = { turn = 30 }", "controller.spotting.turn: expected a number in [0, ");
+  refused("spotting = { turn = \"late\" }", "controller.spotting.turn: expected a number");
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// Where the jump2d landing controller puts the feet (control/jump_controller.h,
-// `landing_at_touchdown` and `landing_reach`). The paper's aim is where the COM would
+// Where the landing module puts the feet (control/module_foot_placement.h, the
+// `foot_placement` settings `at_touchdown` and `reach`; skills/jump_high.toml). The paper's aim is where the COM would
 // cross the floor, which overshoots; the optimized offset that makes up for it holds only
 // for the pitch the input motion comes down with, so a small change of the parameters
 // moved the COM at touch-down by 10 cm or more and the high jump's landings fell. Aimed at
@@ -15,7 +15,6 @@
 #include <random>
 #include <string>
 
-#include "control/jump_controller.h"
 #include "control/skill_controller.h"
 #include "core/error.h"
 #include "support/task_errors.h"
@@ -23,7 +22,7 @@
 #include "robust/robustness.h"
 #include "task/evaluate.h"
 #include "task/task.h"
-#include "support/jump2d_variant.h"
+#include "support/task_variant.h"
 
 namespace diverse {
 namespace {
@@ -31,11 +30,9 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kSource = DIVERSE_SOURCE_DIR;
 
-// jump_high.toml with its landing_at_touchdown and landing_reach lines replaced by
-// `controller` (top of [controller]).
+// jump_high.toml with `controller` at the top of its [controller] table.
 fs::path variant(const std::string& name, const std::string& controller) {
-  return test_files::jump2d_variant("jump_high", "landing_aim_" + name, {"landing_at_touchdown =", "landing_reach ="},
-                                  {{"controller", controller}});
+  return test_files::task_variant("jump_high", "landing_aim_" + name, {}, {{"controller", controller}});
 }
 
 // The COM's horizontal distance ahead of the middle of the soles (the feet's centres of
@@ -66,12 +63,14 @@ TEST(LandingAim, TheHighJumpAsksForIt) {
   EXPECT_EQ(module.kind, "foot_placement");
   EXPECT_EQ(module.settings.at("at_touchdown").number, 1.0);
   EXPECT_DOUBLE_EQ(module.settings.at("reach").number, 0.05);
-  // Off unless asked for: the paper's aim.
-  const Task paper = load_task(variant("paper", "").string());
-  const auto* p = dynamic_cast<const JumpControllerConfig*>(paper.controller_config.get());
-  ASSERT_NE(p, nullptr);
-  EXPECT_FALSE(p->landing_at_touchdown);
-  EXPECT_EQ(p->landing_reach, 0.0);
+  // Off unless asked for: the paper's jump (skills/jump2d.toml) aims the paper's way.
+  const SkillFile paper = load_skill_file(kSource + "/skills/jump2d.toml");
+  const int paper_landing = paper.module_index("landing");
+  ASSERT_GE(paper_landing, 0);
+  const SkillModuleSpec& aim = paper.modules[static_cast<size_t>(paper_landing)];
+  EXPECT_EQ(aim.kind, "foot_placement");
+  EXPECT_EQ(aim.settings.count("at_touchdown"), 0u);
+  EXPECT_EQ(aim.settings.count("reach"), 0u);
 }
 
 // Perturbations of the high jump's input motion at sigma 0.02 (24 of them, seeded): the
@@ -114,10 +113,11 @@ TEST(LandingAim, BadSettingsAreRefused) {
   auto refused = [](const std::string& controller, const std::string& expected) {
     test_files::expect_task_refused(variant("bad", controller).string(), expected);
   };
-  refused("landing_at_touchdown = 1", "controller.landing_at_touchdown");
-  refused("landing_reach = -0.1", "controller.landing_reach");
-  refused("landing_reach = 2.0", "controller.landing_reach");
-  refused("landing_reach = \"fast\"", "controller.landing_reach");
+  refused("landing = { at_touchdown = 2 }", "controller.landing.at_touchdown: expected a number in [0, 1], got 2");
+  refused("landing = { reach = -0.1 }", "controller.landing.reach: expected a number in [0, ");
+  refused("landing = { reach = \"fast\" }", "controller.landing.reach: expected a number");
+  // The skill makes the offset a parameter: a task cannot pin it.
+  refused("landing = { offset = 0.1 }", "controller.landing.offset: expected a number setting (the skill makes landing.offset the parameter");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "physics/rollout.h"
+#include "support/fingerprint.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
@@ -22,16 +23,7 @@ namespace {
 
 const std::string kTasks = std::string(DIVERSE_SOURCE_DIR) + "/tasks/";
 
-// FNV-1a over the bytes of every double: a fingerprint of a trajectory, bit for bit.
-uint64_t fingerprint(const std::vector<double>& values) {
-  uint64_t h = 1469598103934665603ull;
-  for (double v : values) {
-    unsigned char b[sizeof v];
-    std::memcpy(b, &v, sizeof v);
-    for (unsigned char c : b) h = (h ^ c) * 1099511628211ull;
-  }
-  return h;
-}
+using test_files::fingerprint;
 
 struct Pinned {
   double scale;

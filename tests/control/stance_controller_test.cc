@@ -359,8 +359,8 @@ TEST_P(Stance3d, FilmStrip) {
 }
 
 // The planar human (a root of x, z and pitch): stance control as the land phase of
-// "jump2d" runs it (stance_landing), with knee and foot gains (its character file leaves
-// the hips, knees and ankles to the jump's phases).
+// skills/jump_forward.toml runs it (the `stance` module), with knee and foot gains (its
+// character file leaves the hips, knees and ankles to the jump's phases).
 Outcome stand_planar(const std::array<double, 3>& v, double seconds) {
   const Loaded c = load("human2d");
   SimWorker worker(c.model);

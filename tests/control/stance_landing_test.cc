@@ -1,33 +1,36 @@
-// "jump2d" with stance_landing and stand_after (control/jump_controller.h): the land phase
-// run by stance control, then standing up. On jump_forward's input motion found under the
-// default balance servo (tests/control/data/jump_forward.default_servo.m0.json, the task's
-// before it took the stiffer servo, with the task's servo keys removed): it still meets
-// the task at both timesteps, and it holds pushes forward 0.3 to 0.9 s after touch-down,
-// where the paper's land phase (PD toward the land pose plus J^T balance) does not even
-// come to rest balanced without a push. Bad settings
-// of the two keys are refused with the task file's field.
+// The landing by stance control (skills/jump_forward.toml: the land phase's `stance`
+// module with stand_after = 0, control/module_stance.h): the land phase run by stance
+// control, then standing up. On jump_forward's input motion found under the default
+// balance servo and without the crouch's lean
+// (tests/control/data/jump_forward.default_servo.m0.json, under the task with its servo
+// and lean set back): it still meets the task at both timesteps, and it holds pushes
+// forward 0.3 to 0.9 s after touch-down, where the paper's land phase (skills/jump2d.toml
+// with jump_forward's landing aim: PD toward the land pose plus J^T balance) does not even
+// come to rest balanced without a push. Bad settings of the module are refused with the
+// task file's field.
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "core/error.h"
 #include "support/task_errors.h"
-#include "support/jump2d_variant.h"
+#include "support/skill_variant.h"
+#include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
 
 namespace diverse {
 namespace {
 
-// jump_forward.toml with `lines` at the top of its [controller] table in place of the
-// committed file's own landing keys.
+// jump_forward.toml with `lines` at the top of its [controller] table.
 std::string variant(const std::string& name, const std::string& lines) {
-  return test_files::jump2d_variant("jump_forward", "stance_landing_" + name,
-                                  {"stance_landing =", "stand_after =", "stand_duration =", "balance_kp =",
-                                   "balance_kd =", "balance_max_force =", "crouch_lean ="},
-                                  {{"controller", lines}})
-      .string();
+  return test_files::task_variant("jump_forward", "stance_landing_" + name, {}, {{"controller", lines}}).string();
 }
+
+// The servo of the start and the crouch as the input motion was found with it.
+const char* kDefaultServo =
+    "balance = { kp = 1500.0, kd = 300.0, max_force = 400.0 }\n"
+    "lean = { kp = 1500.0, kd = 300.0, max_force = 400.0, lean = 0.0 }";
 
 EvaluationOptions judged() {
   EvaluationOptions o;
@@ -37,8 +40,12 @@ EvaluationOptions judged() {
 }
 
 TEST(StanceLanding, MeetsTheTaskAndHoldsForwardPushesAfterTouchdown) {
-  const Task paper_task = load_task(variant("paper", "stance_landing = false\nstand_after = -1"));
-  const Task stance_task = load_task(variant("stance", "stance_landing = true\nstand_after = 0.0"));
+  const Task paper_task = load_task(test_files::task_variant(
+                                        "jump_forward", "stance_landing_paper", {"skill ="},
+                                        {{"controller", test_files::skill_line("skills/jump2d.toml") +
+                                                            "\nlanding = { at_touchdown = true, reach = 0.05 }"}})
+                                        .string());
+  const Task stance_task = load_task(variant("stance", kDefaultServo));
   const TaskEvaluator paper(paper_task), stance(stance_task);
   const ParameterSet m0 = paper.load_parameters(std::string(DIVERSE_SOURCE_DIR) +
                                                 "/tests/control/data/jump_forward.default_servo.m0.json");
@@ -76,10 +83,11 @@ TEST(StanceLanding, BadSettingsAreRefused) {
   auto refused = [](const std::string& lines, const std::string& expected) {
     test_files::expect_task_refused(variant("bad", lines), expected);
   };
-  refused("stance_landing = false\nstand_after = 0.2", "controller.stand_after: expected stance_landing = true with it");
-  refused("stance_landing = true\nstand_after = 9", "controller.stand_after: expected a number in");
-  refused("stance_landing = true\nstand_duration = 0", "controller.stand_duration: expected a number in");
-  refused("stance_landing = 1", "controller.stance_landing");
+  refused("stance = { stand_after = -2 }", "controller.stance.stand_after: expected a number in [-1, ");
+  refused("stance = { stand_after = \"soon\" }", "controller.stance.stand_after: expected a number");
+  // A stand-up over no time at all divides by zero.
+  refused("stance = { stand_duration = 0 }", "controller.stance.stand_duration: expected a number in [0.05, ");
+  refused("stance = { stand_duration = -0.5 }", "controller.stance.stand_duration: expected a number in [0.05, ");
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 // A standing jump starts from the ground, flat-footed. Two settings of a task file say so:
 // `[simulation] hop_is_fall` (task/task.h): a character that is off the ground for 20 ms
-// or more before its extend phase falls, "left the ground before the jump"; and the jump2d
-// controller's `level_feet` (control/jump_controller.h): the soles stay level in start,
-// crouch and land, and the pose's foot values of those phases are not parameters. The high
+// or more before its extend phase falls, "left the ground before the jump"; and the skill's
+// level feet (skills/jump_high.toml, the target set `level`: the ankles hold the soles at
+// world pitch 0): the soles stay level in start, crouch and land, and the pose's foot
+// values of those phases are not parameters. The high
 // jump's earlier input motion, found without either, snapped into its start pose and hopped
 // for 0.12 s before it crouched, then crouched and landed on the capsule ends of its feet.
 #include <gtest/gtest.h>
@@ -13,13 +14,13 @@
 #include <algorithm>
 #include <string>
 
-#include "control/jump_controller.h"
 #include "control/skill_controller.h"
 #include "core/error.h"
 #include "physics/rollout.h"
 #include "task/evaluate.h"
 #include "task/task.h"
-#include "support/jump2d_variant.h"
+#include "support/skill_variant.h"
+#include "support/task_variant.h"
 
 namespace diverse {
 namespace {
@@ -28,15 +29,29 @@ namespace fs = std::filesystem;
 const std::string kSource = DIVERSE_SOURCE_DIR;
 const std::string kHops = kSource + "/tests/task/data/jump_high_paper_feet.m0.json";
 
-// jump_high.toml with its own level_feet and hop_is_fall lines replaced by `controller`
-// (top of [controller]) and `simulation` (top of [simulation]); the landing aim and the
-// balance servo are the paper's, as the earlier input motion was found with them.
+// The paper's jump (skills/jump2d.toml), and the high jump's skill (skills/jump_high.toml)
+// with its feet level but the paper's landing aim and balance servo, as the earlier input
+// motion was found with them.
+const std::string kPaperFeet = test_files::skill_line("skills/jump2d.toml");
+const std::string kLevelFeet = test_files::skill_line("skills/jump_high.toml") +
+                               "\nlanding = { at_touchdown = false, reach = 0.0 }"
+                               "\nbalance = { kp = 1500.0, kd = 300.0, max_force = 400.0 }";
+
+// jump_high.toml with its skill and its hop_is_fall line replaced by `controller` (top of
+// [controller]) and `simulation` (top of [simulation]).
 fs::path variant(const std::string& name, const std::string& controller, const std::string& simulation) {
-  return test_files::jump2d_variant("jump_high", "standing_start_" + name,
+  return test_files::task_variant("jump_high", "standing_start_" + name,
                                   // The earlier motions were found under MuJoCo's damping at 2 ms.
-                                  {"level_feet =", "hop_is_fall =", "landing_at_touchdown =", "landing_reach =",
-                                   "balance_kp =", "balance_kd =", "balance_max_force =", "damping =", "timestep ="},
+                                  {"skill =", "hop_is_fall =", "damping =", "timestep ="},
                                   {{"controller", controller}, {"simulation", simulation}});
+}
+
+// When the phase of that name began in `e` (s).
+double begin_of(const Evaluation& e, const std::string& phase) {
+  for (size_t k = 0; k < e.phases.names.size(); ++k)
+    if (e.phases.names[k] == phase) return e.phases.begin[k];
+  ADD_FAILURE() << "no phase " << phase;
+  return -1;
 }
 
 struct Footing {
@@ -86,8 +101,8 @@ EvaluationOptions recorded(StepRecorder& rec) {
 }
 
 TEST(StandingStart, AHopBeforeTheJumpIsAFall) {
-  const Task allowed = load_task(variant("hop_allowed", "level_feet = false", "hop_is_fall = false").string());
-  const Task refused = load_task(variant("hop_refused", "level_feet = false", "hop_is_fall = true").string());
+  const Task allowed = load_task(variant("hop_allowed", kPaperFeet, "hop_is_fall = false").string());
+  const Task refused = load_task(variant("hop_refused", kPaperFeet, "hop_is_fall = true").string());
   const TaskEvaluator ev_allowed(allowed), ev_refused(refused);
   const ParameterSet hops = ev_allowed.load_parameters(kHops);
 
@@ -95,7 +110,7 @@ TEST(StandingStart, AHopBeforeTheJumpIsAFall) {
   auto w = ev_allowed.make_worker();
   const Evaluation e = ev_allowed.evaluate(hops.values(), *w, recorded(rec));
   EXPECT_EQ(e.constraint, 0) << "without the rule the hopping jump met the task";
-  const double extend = e.phases.begin[kExtend];
+  const double extend = begin_of(e, "extend");
   const Footing f = footing_before_extend(ev_allowed, rec, extend);
   EXPECT_GT(f.off_ground, 0.1) << "it hops before its extend";
 
@@ -115,19 +130,18 @@ TEST(StandingStart, AHopBeforeTheJumpIsAFall) {
 Footing crouch_of(const std::string& task_file) {
   const Task task = load_task(task_file);
   EXPECT_TRUE(task.simulation.hop_is_fall);
-  // Level feet: jump2d's key, or a skill whose first phase aims the soles level.
-  const auto* config = dynamic_cast<const JumpControllerConfig*>(task.controller_config.get());
+  // Level feet: a skill whose first phase aims the soles level.
   const auto* skill = dynamic_cast<const SkillConfig*>(task.controller_config.get());
-  EXPECT_TRUE((config != nullptr && config->level_feet) || (skill != nullptr && skill->skill->phases[0].targets == "level"));
+  EXPECT_TRUE(skill != nullptr && skill->skill->phases[0].targets == "level") << task_file;
   const TaskEvaluator ev(task);
   StepRecorder rec;
   auto w = ev.make_worker();
   const Evaluation e = ev.evaluate(ev.load_parameters(task.m0).values(), *w, recorded(rec));
   EXPECT_EQ(e.constraint, 0) << task_file;
   // On the ground all the way to the extend (never off it for the rule's 20 ms).
-  const Footing f = footing_before_extend(ev, rec, e.phases.begin[kExtend]);
+  const Footing f = footing_before_extend(ev, rec, begin_of(e, "extend"));
   EXPECT_LT(f.off_ground, 0.01) << task_file;
-  return footing_before_extend(ev, rec, e.phases.begin[kExtend], e.phases.begin[kCrouch]);
+  return footing_before_extend(ev, rec, begin_of(e, "extend"), begin_of(e, "crouch"));
 }
 
 TEST(StandingStart, TheHighJumpCrouchesFlatFootedAndMeetsTheTask) {
@@ -142,18 +156,18 @@ TEST(StandingStart, TheHighJumpCrouchesFlatFootedAndMeetsTheTask) {
 
   // The earlier input motion under the paper's foot targets: off the ground or on one end
   // of each sole for most of its crouch.
-  const Task paper = load_task(variant("paper_feet", "level_feet = false", "hop_is_fall = false").string());
+  const Task paper = load_task(variant("paper_feet", kPaperFeet, "hop_is_fall = false").string());
   const TaskEvaluator ev_paper(paper);
   StepRecorder rec_paper;
   auto w2 = ev_paper.make_worker();
   const Evaluation p = ev_paper.evaluate(ev_paper.load_parameters(kHops).values(), *w2, recorded(rec_paper));
-  const Footing fp = footing_before_extend(ev_paper, rec_paper, p.phases.begin[kExtend], p.phases.begin[kCrouch]);
+  const Footing fp = footing_before_extend(ev_paper, rec_paper, begin_of(p, "extend"), begin_of(p, "crouch"));
   EXPECT_LT(fp.flat_steps, 0.5 * fp.steps) << fp.flat_steps << " of " << fp.steps;
 }
 
 TEST(StandingStart, LevelFeetAreNotParameters) {
-  const Task level = load_task(variant("level", "level_feet = true", "hop_is_fall = true").string());
-  const Task paper = load_task(variant("paper", "level_feet = false", "hop_is_fall = true").string());
+  const Task level = load_task(variant("level", kLevelFeet, "hop_is_fall = true").string());
+  const Task paper = load_task(variant("paper", kPaperFeet, "hop_is_fall = true").string());
   const auto names = [](const Task& t) {
     std::vector<std::string> n;
     const TaskEvaluator ev(t);
@@ -182,8 +196,7 @@ TEST(StandingStart, BadSettingsAreRefused) {
       EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
     }
   };
-  refused("level_feet = 1", "hop_is_fall = true", "controller.level_feet");
-  refused("level_feet = true", "hop_is_fall = \"yes\"", "simulation.hop_is_fall");
+  refused(kLevelFeet, "hop_is_fall = \"yes\"", "simulation.hop_is_fall");
 }
 
 }  // namespace

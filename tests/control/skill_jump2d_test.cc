@@ -1,9 +1,9 @@
-// The planar human and its jump controller: the model is what section 5 of the paper
-// says, every parameter is named and ranged, normalization round-trips, parameter files
-// are read strictly, and the controller's phases happen in order with torques that stay
-// within the joint limits and never act on the root.
-#include "control/jump_controller.h"
-
+// The planar human and its jump (skills/jump2d.toml and the skills made from it, run by
+// the skill engine): the model is what section 5 of the paper says, every parameter is
+// named and ranged, normalization round-trips, parameter files are read strictly, the
+// phases happen in order with torques that stay within the joint limits and never act on
+// the root, and the flight's timing (a rise or fall duration capped by `at_most`, a rise
+// that ends on `turned`) does what the skill file says.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,10 +17,13 @@
 #include "character/character.h"
 #include "physics/drive.h"
 #include "control/parameters.h"
+#include "control/skill_controller.h"
 #include "core/error.h"
 #include "physics/model.h"
 #include "task/evaluate.h"
 #include "support/scratch.h"
+#include "support/skill_variant.h"
+#include "support/text_files.h"
 
 namespace diverse {
 namespace {
@@ -117,7 +120,7 @@ TEST(Parameters, FilesAreReadStrictly) {
 }
 
 // The base jump runs the phases in order and keeps every joint torque within its limit.
-TEST(JumpController, PhasesInOrderTorquesWithinLimits) {
+TEST(PlanarJump, PhasesInOrderTorquesWithinLimits) {
   const TaskEvaluator ev(load_task(kRoot + "/tasks/jump_high.toml"));
   const ParameterSet p = ev.load_parameters(kRoot + "/tasks/jump_high_start.json");
   auto worker = ev.make_worker();
@@ -127,10 +130,11 @@ TEST(JumpController, PhasesInOrderTorquesWithinLimits) {
   const Evaluation e = ev.evaluate(p.values(), *worker, options);
   ASSERT_FALSE(e.failed);
   const PhaseTimes& t = e.phases;
-  EXPECT_EQ(t.begin[kStart], 0.0);
-  EXPECT_NEAR(t.begin[kCrouch], p.get("start.duration"), 0.0021);
-  EXPECT_NEAR(t.begin[kExtend] - t.begin[kCrouch], p.get("crouch.duration"), 0.0021);
-  EXPECT_GT(t.takeoff(), t.begin[kExtend]);
+  ASSERT_EQ(t.names, (std::vector<std::string>{"start", "crouch", "extend", "rise", "fall", "land"}));
+  EXPECT_EQ(t.begin[0], 0.0);
+  EXPECT_NEAR(t.begin[1], p.get("start.duration"), 0.0021);
+  EXPECT_NEAR(t.begin[2] - t.begin[1], p.get("crouch.duration"), 0.0021);
+  EXPECT_GT(t.takeoff(), t.begin[2]);
   EXPECT_GT(t.peak(), t.takeoff());
   EXPECT_GT(t.landing(), t.peak());
   EXPECT_GT(e.summary.peak_com_z, 0.95);  // it does leave the ground
@@ -144,26 +148,28 @@ TEST(JumpController, PhasesInOrderTorquesWithinLimits) {
 }
 
 
-// The backflip task with its flight timing (tuck_time, open_time, open_rotation) replaced
-// by `controller_lines` in its [controller] table, written to a scratch directory (with
-// the files it names). The backflip these options were made for: its input motion found
-// with the joint drive's explicit way at 1 ms (tests/task/data/backflip_explicit.toml).
-std::string backflip_with(const std::string& name, const std::string& controller_lines) {
+// The backflip as its earlier input motion was found (tests/task/data/backflip_explicit.toml:
+// the joint drive's explicit way at 1 ms, its skill backflip_open_rotation.skill.toml) with
+// `replace` applied to its skill file, written to a scratch directory with the files it
+// names. The skill's flight timing, which these variants change:
+//   rise  duration = { predict = "rise", at_most = 0.08 }: the tuck reached 0.08 s after
+//         take-off, or at the predicted peak if sooner;
+//         next on ["peak", "turned"], angle = 3.3: held past the peak until the root has
+//         turned 3.3 rad since take-off;
+//   fall  duration = { predict = "touchdown", at_most = 0.1 }: open within 0.1 s, or at the
+//         predicted touch-down if sooner.
+std::string backflip_with(const std::string& name, const std::vector<std::pair<std::string, std::string>>& replace) {
   const std::string data = kRoot + "/tests/task/data/";
-  std::ifstream in(data + "backflip_explicit.toml");
-  std::string toml, line;
-  while (std::getline(in, line)) {
-    if (line.rfind("tuck_time", 0) == 0 || line.rfind("open_time", 0) == 0 || line.rfind("open_rotation", 0) == 0)
-      continue;
-    toml += line + "\n";
-  }
-  const std::string key = "type = \"jump2d\"\n";
+  const std::filesystem::path skill =
+      test_files::skill_variant("tests/task/data/backflip_open_rotation.skill.toml", "backflip_" + name, replace);
+  std::string toml = test_files::read_text(data + "backflip_explicit.toml");
+  const std::string key = "skill = \"backflip_open_rotation.skill.toml\"";
   const std::string character = "../../../assets/characters/human2d.toml";
   const std::string base = "../../../tasks/backflip_start.json";
   if (toml.find(key) == std::string::npos || toml.find(character) == std::string::npos ||
       toml.find(base) == std::string::npos)
     return "";
-  toml.replace(toml.find(key), key.size(), key + controller_lines);
+  toml.replace(toml.find(key), key.size(), test_files::skill_line(skill));
   toml.replace(toml.find(character), character.size(), kRoot + "/assets/characters/human2d.toml");
   toml.replace(toml.find(base), base.size(), kRoot + "/tasks/backflip_start.json");
   const std::filesystem::path dir = test_files::scratch_dir(name);
@@ -172,6 +178,18 @@ std::string backflip_with(const std::string& name, const std::string& controller
   std::ofstream(dir / "backflip.toml") << toml;
   return (dir / "backflip.toml").string();
 }
+
+// The edits: the tuck reached at the predicted peak (no cap), the fall's duration
+// predicted from the peak (without or with the 0.1 s cap) or from where it begins
+// (uncapped), the rise ended at the peak alone, or only once the root has turned 3.49 rad.
+const std::pair<std::string, std::string> kTuckAtPeak = {"{ predict = \"rise\", at_most = 0.08 }", "{ predict = \"rise\" }"};
+const std::pair<std::string, std::string> kOpenAtTouchdown = {"{ predict = \"touchdown\", at_most = 0.1 }", "{ predict = \"fall\" }"};
+const std::pair<std::string, std::string> kOpenSoon = {"{ predict = \"touchdown\", at_most = 0.1 }",
+                                                       "{ predict = \"fall\", at_most = 0.1 }"};
+const std::pair<std::string, std::string> kOpenFromHere = {"{ predict = \"touchdown\", at_most = 0.1 }",
+                                                           "{ predict = \"touchdown\" }"};
+const std::pair<std::string, std::string> kFallAtPeak = {"on = [\"peak\", \"turned\"], angle = 3.3", "on = \"peak\""};
+const std::pair<std::string, std::string> kFallWhenTurned = {"angle = 3.3", "angle = 3.49"};
 
 struct Recorded {
   Evaluation e;
@@ -204,15 +222,15 @@ void expect_same_until(const Recorded& a, const Recorded& b, double seconds) {
     ASSERT_EQ(a.record.qpos[static_cast<size_t>(k)], b.record.qpos[static_cast<size_t>(k)]) << "step " << k / a.record.nq;
 }
 
-// [controller] tuck_time: the rise phase reaches its targets that long after take-off
-// instead of at the predicted peak; open_time: the fall phase reaches its targets that
-// long after the peak instead of at the predicted touch-down. Before the phase they change
-// the motion is the same to the bit; soon after, the knees are much nearer the phase's
-// target.
-TEST(JumpController, TuckAndOpenTimesReachTheFlightTargetsSoonerAndChangeNothingBefore) {
-  const std::string plain_file = backflip_with("plain", "");
-  const std::string tuck_file = backflip_with("tuck_time", "tuck_time = 0.08\n");
-  const std::string open_file = backflip_with("open_time", "tuck_time = 0.08\nopen_time = 0.1\n");
+// A predicted duration capped with `at_most`: the rise phase reaches its targets 0.08 s
+// after take-off instead of at the predicted peak (a quick tuck); the fall phase 0.1 s
+// after the peak instead of at the predicted touch-down (opening in time to land). Before
+// the phase they change the motion is the same to the bit; soon after, the knees are much
+// nearer the phase's target.
+TEST(PlanarJump, CappedFlightDurationsReachTheTargetsSoonerAndChangeNothingBefore) {
+  const std::string plain_file = backflip_with("plain", {kTuckAtPeak, kOpenAtTouchdown, kFallAtPeak});
+  const std::string tuck_file = backflip_with("tuck_time", {kOpenAtTouchdown, kFallAtPeak});
+  const std::string open_file = backflip_with("open_time", {kOpenSoon, kFallAtPeak});
   ASSERT_FALSE(tuck_file.empty());
   const TaskEvaluator ev(load_task(kRoot + "/tasks/backflip.toml"));
   const Recorded plain = simulate_m0(plain_file);
@@ -250,12 +268,12 @@ TEST(JumpController, TuckAndOpenTimesReachTheFlightTargetsSoonerAndChangeNothing
 }
 
 
-// [controller] open_rotation: the rise phase (the tuck) lasts past the peak until the root
-// has turned that far since take-off; only then does the fall phase (opening for the
-// landing) begin. Up to the peak nothing changes; the flip turns further in the air.
-TEST(JumpController, OpenRotationHoldsTheTuckUntilTheRootHasComeRound) {
-  const std::string tuck_file = backflip_with("open_rotation_tuck", "tuck_time = 0.08\n");
-  const std::string late_file = backflip_with("open_rotation", "tuck_time = 0.08\nopen_rotation = 3.49\n");
+// A rise that ends on ["peak", "turned"]: the tuck lasts past the peak until the root has
+// turned `angle` since take-off; only then does the fall phase (opening for the landing)
+// begin. Up to the peak nothing changes; the flip turns further in the air.
+TEST(PlanarJump, ATurnedTransitionHoldsTheTuckUntilTheRootHasComeRound) {
+  const std::string tuck_file = backflip_with("open_rotation_tuck", {kOpenAtTouchdown, kFallAtPeak});
+  const std::string late_file = backflip_with("open_rotation", {kOpenFromHere, kFallWhenTurned});
   ASSERT_FALSE(tuck_file.empty());
   const TaskEvaluator ev(load_task(late_file));
   const Recorded tuck = simulate_m0(tuck_file);
@@ -278,10 +296,11 @@ TEST(JumpController, OpenRotationHoldsTheTuckUntilTheRootHasComeRound) {
   EXPECT_GT(std::fabs(late.e.summary.rotation_flight), std::fabs(tuck.e.summary.rotation_flight) + 0.2);
 }
 
-// The controller wraps angles to [-pi, pi] with std::remainder only when they lie outside:
+// The engine wraps angles to [-pi, pi] with std::remainder only when they lie outside
+// (skill_wrap, control/skill_controller.h):
 // inside, remainder(a, 2 pi) is a itself, bit for bit, which this checks on the edges and
 // on a million angles, so the shortcut changes no motion.
-TEST(JumpController, AnAngleWithinPiIsItsOwnRemainder) {
+TEST(PlanarJump, AnAngleWithinPiIsItsOwnRemainder) {
   std::vector<double> angles = {0.0, -0.0, M_PI, -M_PI, std::nextafter(M_PI, 0.0), std::nextafter(-M_PI, 0.0),
                                 1e-300, -1e-300, 0.5 * M_PI, -0.5 * M_PI};
   unsigned long long state = 88172645463325252ULL;
@@ -291,14 +310,17 @@ TEST(JumpController, AnAngleWithinPiIsItsOwnRemainder) {
     state ^= state << 17;
     angles.push_back((static_cast<double>(state >> 11) * 0x1.0p-53 * 2 - 1) * M_PI);
   }
-  int differ = 0;
+  int differ = 0, wrapped_differ = 0;
   for (double a : angles) {
-    const double r = std::remainder(a, 2 * M_PI);
+    const double r = std::remainder(a, 2 * M_PI), w = skill_wrap(a);
     if (std::memcmp(&r, &a, sizeof a) != 0) ++differ;
+    if (std::memcmp(&r, &w, sizeof a) != 0) ++wrapped_differ;
   }
   EXPECT_EQ(differ, 0);
+  EXPECT_EQ(wrapped_differ, 0);
   // Just outside, it wraps.
   EXPECT_LT(std::remainder(std::nextafter(M_PI, 4.0), 2 * M_PI), 0.0);
+  for (double a : {std::nextafter(M_PI, 4.0), 4.0, -7.5, 20.0}) EXPECT_EQ(skill_wrap(a), std::remainder(a, 2 * M_PI)) << a;
 }
 
 }  // namespace
