@@ -1,8 +1,11 @@
 // The controller seam: controllers are plug-ins chosen by name in the task file.
 //
 //   [controller]
-//   type = "jump2d"          # a registered ControllerType
-//   landing_control = true   # ...and that type's own keys
+//   type = "skill"                    # a registered ControllerType (the default with `skill`)
+//   skill = "../skills/jump2d.toml"   # ...and that type's own keys
+//
+// Every skill is a file run by one type, the skill engine (control/skill_controller.h);
+// the seam stays for a controller that cannot be written as one.
 //
 // A ControllerType parses its own keys, names and ranges its free parameters for a given
 // character (control/parameters.h), and makes one Controller per rollout. The task,

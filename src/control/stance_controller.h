@@ -1,5 +1,5 @@
 // Stance control for a character with a free root (the 3D human, the bird robot) or a
-// planar one (the land phase of "jump2d" with stance_landing): balance
+// planar one (the land phase of skills/jump_forward.toml, control/module_stance.h): balance
 // on the feet in contact, body upright, feet flat, every other joint toward a pose.
 //
 //   StanceController stance(body, m);        // targets: the model's standing pose qpos0

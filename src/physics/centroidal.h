@@ -5,8 +5,8 @@
 // In flight the momentum is constant (no contact, gravity acts at the COM), and the
 // inertia follows the pose: a tucked body turns fast, an open one slowly. A controller that
 // knows both predicts how far the body will have turned by touch-down if it opened now,
-// the way a gymnast times the opening of a flip (control/jump_controller.h,
-// open_touchdown_pitch). It reads what mj_step1 computed (xipos, ximat, cvel,
+// the way a gymnast times the opening of a flip (the skill engine's spotting module,
+// control/module_spotting.h). It reads what mj_step1 computed (xipos, ximat, cvel,
 // subtree_com) and writes nothing to mjData.
 #pragma once
 

@@ -32,6 +32,17 @@ std::string existing_file(const TomlReader& r, const char* key) {
 }
 
 void read_controller(const TomlReader& r, Task& task) {
+  // The planar jump controller "jump2d" became the skill file skills/jump2d.toml: a task
+  // that still names it is told the line to write instead, relative to the task file.
+  if (r.has("type") && r.string("type") == "jump2d") {
+    const fs::path skill = fs::path(DIVERSE_SOURCE_DIR) / "skills" / "jump2d.toml";
+    const fs::path from = fs::absolute(r.file()).lexically_normal().parent_path();
+    std::string relative = skill.lexically_normal().lexically_relative(from).string();
+    if (relative.empty()) relative = skill.lexically_normal().string();
+    r.fail("type", "expected skill = \"" + relative +
+                       "\" in place of type = \"jump2d\" (that controller is this skill file now, its keys the "
+                       "settings of the skill's modules: docs/reference/skills.md)");
+  }
   // A skill file names the skill engine ("skill"); otherwise a controller type by name.
   task.controller = r.has("skill") && !r.has("type") ? "skill" : r.string("type");
   task.controller_type = &find_controller(task.controller, r.file() + ": " + r.field("type"));

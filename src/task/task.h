@@ -171,7 +171,7 @@ struct Task {
   std::string character;    // resolved character file (character/character.h)
   std::shared_ptr<const CharacterSpec> character_spec;  // that file, parsed
   std::string model;        // resolved MJCF path of the character (character_spec->model)
-  std::string controller = "jump2d";                   // [controller] type
+  std::string controller = "skill";                    // [controller] type
   const ControllerType* controller_type = nullptr;     // its plug-in
   std::shared_ptr<const ControllerConfig> controller_config;  // its own keys
   std::vector<SceneObject> objects;

@@ -467,6 +467,27 @@ TEST(BadInput, RobustnessOptionsAndInputs) {
   for (const Case& c : cases) expect_user_error(c);
 }
 
+// A task file that still names the planar jump controller "jump2d", which became the skill
+// file skills/jump2d.toml: one line naming the file and the field, with the line to write
+// instead (the path relative to the task file), for every command that reads a task.
+TEST(BadInput, TheRetiredJumpControllerNamesItsSkillFile) {
+  const fs::path dir = scratch("retired_jump2d");
+  const fs::path file = dir / "tasks" / "old_jump.toml";
+  write(file, task_text("jump_high", {{"skill = \"" + kSource + "/skills/jump_high.toml\"",
+                                       "type = \"jump2d\"\nlanding_control = true\nlevel_feet = true"}}));
+  const std::string relative = (fs::path(kSource) / "skills/jump2d.toml")
+                                   .lexically_normal()
+                                   .lexically_relative(fs::absolute(file).lexically_normal().parent_path())
+                                   .string();
+  const std::string expected = file.string() + ": controller.type: expected skill = \"" + relative +
+                               "\" in place of type = \"jump2d\" (that controller is this skill file now";
+  for (const std::string& command : {"simulate " + file.string() + " --no-film --out " + (dir / "out").string(),
+                                     "run " + file.string() + " --generations 1 --out " + (dir / "run").string(),
+                                     "seed-motion " + file.string() + " --generations 1"}) {
+    expect_user_error({command, expected});
+  }
+}
+
 // `diverse replay MOTION --task FILE` with a task of another controller or character than
 // the motion's: refused before anything is replayed (it once replayed a jump "against" a
 // walk and exited 0). The motion's own task is accepted.
@@ -484,10 +505,10 @@ TEST(BadInput, ReplayAgainstATaskOfAnotherSkill) {
        "motion.json: parameters: expected the parameters of skill 'jump3d' for character 'human3d'"},
       {"replay " + motion + " --task robot_jump", "motion.json: parameters: expected the parameters of skill 'robot_jump'"},
       {"replay " + motion + " --task " + kSource + "/examples/own-character/leap.toml", "motion.json: "},
-      // The same controller and character with the paper's foot targets: 90 parameters,
-      // where the high jump's level feet leave 87.
+      // The same character under the paper's jump (skills/jump2d.toml), with its foot
+      // targets: 90 parameters, where the high jump's level feet leave 87.
       {"replay " + motion + " --task " + kSource + "/tests/task/data/jump_high_paper_feet.toml",
-       "motion.json: parameters: expected the parameters of controller 'jump2d' for character 'human2d' (task " +
+       "motion.json: parameters: expected the parameters of skill 'jump2d' for character 'human2d' (task " +
            kSource + "/tests/task/data/jump_high_paper_feet.toml): 90 of them, got 87 of a motion of task 'jump_high'"},
   };
   for (const Case& c : cases) expect_user_error(c);

@@ -27,7 +27,7 @@ std::string valid_text() {
          "variations = 4\n"
          "m0 = \"t.m0.json\"\n"
          "[controller]\n"
-         "type = \"jump2d\"\n"
+         "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/jump2d.toml\"\n"
          "[constraints]\n"
          "weight = 5000.0\n"
          "fall_penalty = 100000.0\n"
@@ -63,26 +63,45 @@ class TaskFileTest : public ::testing::Test {
 };
 
 // The controller is a plug-in chosen by name; an unknown name lists the known ones, and a
-// controller that cannot drive the character says why before any simulation.
+// skill that cannot drive the character says why before any simulation.
 TEST_F(TaskFileTest, ControllerTypeIsLookedUpAndCheckedAgainstTheCharacter) {
-  EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"walk9\"")),
-            ": controller.type: expected one of \"jump2d\", \"skill\", got \"walk9\"");
-  EXPECT_EQ(error_of(replace(valid_text(), "type = \"jump2d\"", "type = \"jump2d\"\nbounce = 2")),
-            ": controller.bounce: expected no such key (unknown key; known keys: type, landing_control, "
-            "landing_height, extend_timeout, tuck_time, open_time, open_rotation, open_turn, balance_kp, balance_kd, balance_max_force, crouch_lean, gravity_compensation, "
-            "stance_landing, stand_after, stand_duration, level_feet, landing_reach, landing_at_touchdown)");
+  const std::string skill = "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/jump2d.toml\"";
+  EXPECT_EQ(error_of(replace(valid_text(), skill, "type = \"walk9\"")),
+            ": controller.type: expected one of \"skill\", got \"walk9\"");
+  EXPECT_EQ(error_of(replace(valid_text(), skill, skill + "\nbounce = 2")),
+            ": controller.bounce: expected no such key (unknown key; known keys: type, skill, landing_height, balance, "
+            "landing, the last the skill's modules as tables)");
   const Task planar = load_task(write(valid_text()));
-  EXPECT_EQ(planar.controller_type->name(), std::string("jump2d"));
+  EXPECT_EQ(planar.controller_type->name(), std::string("skill"));
+  EXPECT_EQ(planar.controller, "skill");
   EXPECT_EQ(planar.character_spec->name, "human2d");
-  // The 3D human has a free root: jump2d refuses it when the task is evaluated.
+  // The 3D human has a free root: the planar skill refuses it when the task is evaluated.
   const std::string path = write(replace(valid_text(), "human2d.xml", "human3d.toml"));
   try {
     TaskEvaluator ev(load_task(path));
-    ADD_FAILURE() << "jump2d accepted a free-root character";
+    ADD_FAILURE() << "skills/jump2d.toml accepted a free-root character";
   } catch (const UserError& e) {
-    EXPECT_EQ(std::string(e.what()), path + ": controller.type: expected a character with a planar root for "
-                                            "\"jump2d\", but the character " + std::string(DIVERSE_SOURCE_DIR) +
-                                            "/assets/characters/human3d.toml has a free root");
+    EXPECT_EQ(std::string(e.what()), std::string(DIVERSE_SOURCE_DIR) +
+                                         "/skills/jump2d.toml: line 6: root: expected a character with a planar root, "
+                                         "but the character " + std::string(DIVERSE_SOURCE_DIR) +
+                                         "/assets/characters/human3d.toml has a free root");
+  }
+}
+
+// The planar jump controller "jump2d" is the skill file skills/jump2d.toml now: a task
+// that names it is told what to write instead, the path relative to the task file.
+TEST_F(TaskFileTest, TheRetiredJumpControllerNamesItsSkillFile) {
+  const std::string skill = "skill = \"" + std::string(DIVERSE_SOURCE_DIR) + "/skills/jump2d.toml\"";
+  const fs::path dir = fs::temp_directory_path() / ("diverse_task_test_" + std::to_string(::getpid()));
+  const std::string from = (fs::path(DIVERSE_SOURCE_DIR) / "skills/jump2d.toml")
+                               .lexically_normal()
+                               .lexically_relative(fs::absolute(dir).lexically_normal())
+                               .string();
+  for (const char* keys : {"type = \"jump2d\"", "type = \"jump2d\"\nlanding_control = true\nlevel_feet = true"}) {
+    EXPECT_EQ(error_of(replace(valid_text(), skill, keys)),
+              ": controller.type: expected skill = \"" + from +
+                  "\" in place of type = \"jump2d\" (that controller is this skill file now, its keys the settings of "
+                  "the skill's modules: docs/reference/skills.md)");
   }
 }
 
