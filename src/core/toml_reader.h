@@ -158,8 +158,15 @@ class TomlReader {
     r.lines_ = lines_;
     return r;
   }
+  // A reader of another table under the same name (a trimmed copy of this one's).
+  TomlReader with_table(const toml::table& t) const {
+    TomlReader r(file_, t, path_);
+    r.lines_ = lines_;
+    return r;
+  }
   const toml::table& raw() const { return table_; }
   const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }  // "constraints.landing", "" at the root
 
  private:
   std::string file_;

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "task/term_landing.h"
+
 namespace diverse {
 
 FilmColumns jump_film_columns(const Evaluation& e, const StepRecorder& record) {
@@ -142,14 +144,14 @@ std::string film_title(const std::string& prefix, const std::vector<std::string>
 
 std::vector<GroundStrip> task_ground_strips(const Task& task) {
   std::vector<GroundStrip> strips;
-  const TaskConstraints& c = task.constraints;
-  if (c.landing && c.landing_radius > 0) {
-    GroundStrip disc{c.landing_center - c.landing_radius, c.landing_center + c.landing_radius};
-    disc.radius = c.landing_radius;
-    disc.y = c.landing_lateral;
+  const LandingConstraint* c = task.constraints.find<LandingConstraint>();
+  if (c != nullptr && c->radius > 0) {
+    GroundStrip disc{c->center - c->radius, c->center + c->radius};
+    disc.radius = c->radius;
+    disc.y = c->lateral;
     strips.push_back(disc);
-  } else if (c.landing) {
-    strips.push_back({c.landing_center - c.landing_half_width, c.landing_center + c.landing_half_width});
+  } else if (c != nullptr) {
+    strips.push_back({c->center - c->half_width, c->center + c->half_width});
   }
   return strips;
 }

@@ -6,10 +6,10 @@
 // very start (progress 0), so that an optimizer starting among falls still sees which
 // candidates stay up longer (ours; the paper only says "a large constant penalty").
 // Never leaving the ground, or never landing, counts as a fall. A rollout whose
-// simulation blew up costs 3 * fall_penalty. The backflip's rotation requirement adds
-// rotation_penalty plus K_c d^2 when the root's rotation from start to end misses
-// turns * 2 pi by more than the tolerance; a minimum rotation in the air (min_flight)
-// adds K_c d^2 for a shortfall of d rad between take-off and the first touch-down.
+// simulation blew up costs 3 * fall_penalty. Every constraint the task lists adds its own
+// terms (task/term.h; each kind's file, task/term_<kind>.h, says which): the landing
+// spot, a box's top, an obstacle's clearance, a length, the peak height, a rotation about
+// pitch, roll or the vertical, the forward pitch, the foot slip.
 //
 // The half-timestep check (half_timestep): a motion that meets the task is simulated
 // again with the timestep halved (TaskEvaluator, EvaluationOptions::half_timestep_check);
@@ -25,9 +25,11 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "task/task.h"
+#include "task/term.h"
 #include "task/walk_task.h"
 
 namespace diverse {
@@ -47,11 +49,15 @@ struct MotionSummary {
   double touchdown_feet_x = 0, touchdown_feet_y = 0, touchdown_feet_z = 0;  // m, the same at the first touch-down
   double rotation_total = 0;  // rad, root pitch at the end minus at the start
   double rotation_flight = 0; // rad, root pitch at landing minus at take-off
+  // rad, a free root's turn between take-off and the first touch-down about the world's
+  // forward axis x (roll, positive turning the left side up) and about the vertical
+  // (positive turning left seen from above); 0 for a planar root (task/term_rotation.h).
+  double roll_flight = 0, vertical_flight = 0;
   double min_clearance = 0;   // m, smallest body-obstacle distance (clearance_range if never near)
   double max_forward_pitch = 0;  // rad, the root's largest forward pitch from standing (3D)
   double end_time = 0;        // s
   // m, the largest slide of a planted foot in one stance (task/foot_slip.h), measured in
-  // the rollout when the task bounds it (TaskConstraints::foot_slip); 0 otherwise.
+  // the rollout when the task bounds it (task/term_foot_slip.h); 0 otherwise.
   double foot_slip = 0;
   // The rollout was ended once the motion could no longer meet the task
   // (EvaluationOptions::end_when_decided). A jump (ended once landed): the feet "at rest"
@@ -73,17 +79,16 @@ struct ConstraintReport {
   std::vector<ConstraintTerm> terms;
   double total = 0;  // C
   bool fell = false;
+  void add(std::string name, double violation, double penalty) {
+    terms.push_back({std::move(name), violation, penalty});
+    total += penalty;
+  }
 };
 
+// C: the fixed terms (a blown-up simulation, a fall, a rollout ended once decided), then
+// every listed constraint's terms in the task's order (task/term.h); a walk task's own
+// terms come from walk_constraints() (task/walk_task.h).
 ConstraintReport evaluate_constraints(const Task& task, const MotionSummary& motion);
-
-// How far (m) the motion's worst stance slid beyond the task's bound (0 within it, or
-// without one): the violation of the term "foot_slip", K_c d^2, of jumps and walks alike.
-double foot_slip_excess(const TaskConstraints& c, const MotionSummary& motion);
-// Its share of constraint_margin(): 0.1 m times the share of the bound left unused (a
-// stance that slides half the bound counts as 5 cm of slack, as a landing 5 cm inside its
-// box does); infinite without a bound.
-double foot_slip_margin(const TaskConstraints& c, const MotionSummary& motion);
 
 // Two simulations of one motion at different timesteps agree when the feet land within
 // this distance (m) of the same spot, at touch-down and at rest.
@@ -100,19 +105,20 @@ double landing_shift(const MotionSummary& a, const MotionSummary& b);
 ConstraintTerm half_timestep_term(const Task& task, const MotionSummary& coarse,
                                   const MotionSummary& fine, double fine_c);
 
-// Lower bounds on a jump's C from what is known part-way through its rollout, for telling
-// when its outcome is decided (TaskEvaluator: Evaluation::steps_after_decided), never for C
-// itself. peak_bound(): once the peak is behind, the peak-height term; touchdown_bound():
-// at the first touch-down, every term the rest of the motion can only make worse (the
-// landing spot and rotation in the air, the obstacle clearance, the forward pitch, the
-// peak), with the feet at rest taken to be where they touched down.
-double peak_bound(const Task& task, const MotionSummary& motion);
+// When a jump's outcome is decided part-way through its rollout (TaskEvaluator:
+// Evaluation::steps_after_decided), never for C itself. broken_at(): some constraint is
+// broken for good by what the rollout has shown up to `moment` (the peak height once the
+// peak is behind; the obstacle clearance or the forward pitch at any step). touchdown_bound():
+// at the first touch-down, a lower bound on C from every term the rest of the motion can
+// only make worse (the landing spot and rotation in the air, the obstacle clearance, the
+// forward pitch, the peak), with the feet at rest taken to be where they touched down.
+bool broken_at(const Task& task, const MotionSummary& motion, Moment moment);
 double touchdown_bound(const Task& task, const MotionSummary& motion);
 
 // How far inside the allowed region the motion is: the smallest slack (m) over the
-// task's geometric constraints (landing box, box edges, clearance, length, peak height;
-// rotation slack counts 0.2 m per rad; a foot-slip bound as foot_slip_margin() says),
-// negative when violated. Used only to prefer
+// task's constraints (Constraint::margin(): landing box, box edges, clearance, length,
+// peak height; rotation and pitch slack count 0.2 m per rad; a foot-slip bound 0.1 m
+// times the share of it left unused), at most 1 m, negative when violated. Used only to prefer
 // robust input motions when seeding (`diverse seed-motion`), never inside C.
 double constraint_margin(const Task& task, const MotionSummary& motion);
 

@@ -3,280 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "core/error.h"
 #include "core/text_file.h"
-#include "task/foot_slip.h"
+#include "task/jump_eval.h"
+#include "task/rollout_terms.h"
 #include "task/scene_check.h"
-#include "task/support.h"
 #include "task/walk_eval.h"
 
 namespace diverse {
 namespace {
-
-// Drives the controller and watches the motion until its outcome is decided.
-class JumpHooks : public StepHooks {
- public:
-  JumpHooks(const Task& task, const Character& body, Controller& controller, JointDrive& drive,
-            int obstacle_geom, bool end_when_decided, Evaluation& out)
-      : task_(task), body_(body), controller_(controller), drive_(drive), obstacle_(obstacle_geom),
-        end_when_decided_(end_when_decided), out_(out), rise_(controller.phase_times().rise), fall_(controller.phase_times().fall),
-        land_(controller.phase_times().land), extend_(controller.phase_times().extend) {
-    out_.summary.min_clearance = task.simulation.clearance_range;
-  }
-
-  void control(mjModel* m, mjData* d) override {
-    contacts_ = scan_contacts(m, d, body_);
-    if (first_) controller_.reset(m, d);
-    controller_.control(m, d, contacts_, drive_);
-  }
-
-  // Observed steps from which the motion could no longer meet the task (-1: none yet).
-  long decided_at() const { return decided_; }
-  long observed() const { return index_; }
-
-  bool observe(const mjModel* m, const mjData* d) override {
-    MotionSummary& s = out_.summary;
-    const double t = d->time;
-    ++index_;
-    const double pitch = root_pitch(m, d);
-    last_pitch_ = pitch;
-    const int phase = controller_.phase();
-    const bool changed = controller_.phase_changed();
-    if (first_) {
-      pitch0_ = pitch;
-      first_ = false;
-      s.standing_com_z = controller_.com()[2];
-      if (body_.root == RootKind::kFree) {
-        // The root's standing "up" and forward axes in its own frame (from qpos0).
-        const double* q0 = m->qpos0 + body_.root_qpos + 3;
-        const double inv[4] = {q0[0], -q0[1], -q0[2], -q0[3]};
-        const double z[3] = {0, 0, 1}, x[3] = {1, 0, 0};
-        mju_rotVecQuat(up0_, z, inv);
-        double fwd0[3];
-        mju_rotVecQuat(fwd0, x, inv);
-        // Forward pitch is measured against the standing forward axis's elevation.
-        double w[3];
-        mju_rotVecQuat(w, fwd0, q0);
-        elevation0_ = std::atan2(w[2], std::hypot(w[0], w[1]));
-        for (int i = 0; i < 3; ++i) fwd0_[i] = fwd0[i];
-      }
-    }
-    s.max_forward_pitch = std::max(s.max_forward_pitch, forward_pitch(d, pitch));
-    const double com_z = controller_.com()[2];
-
-    // Events.
-    if (phase == rise_ && changed) {
-      s.took_off = true;
-      pitch_takeoff_ = pitch;
-    }
-    const bool airborne = phase == rise_ || phase == fall_;
-    if (airborne || (phase == land_ && changed && s.took_off)) {
-      out_.flight_time.push_back(t);
-      out_.flight_qpos.insert(out_.flight_qpos.end(), d->qpos, d->qpos + m->nq);
-    }
-    if (airborne) s.peak_com_z = std::max(s.peak_com_z, com_z);
-    if (phase == fall_ && changed) decide_if(peak_bound(task_, s) > 0);  // the peak is behind
-    if (phase == land_ && changed) {
-      if (!s.took_off || controller_.gave_up()) return fall(t, "never left the ground", d);
-      s.landed = true;
-      s.rotation_flight = pitch - pitch_takeoff_;
-      s.touchdown_feet_x = feet_mean(d, 0);
-      s.touchdown_feet_y = feet_mean(d, 1);
-      s.touchdown_feet_z = feet_mean(d, 2);
-      decide_if(touchdown_bound(task_, s) > 0);
-    }
-
-    // Obstacle proximity (contacts in the margin gap included).
-    if (obstacle_ >= 0) {
-      for (int i = 0; i < d->ncon; ++i) {
-        const mjContact& c = d->contact[i];
-        if (c.geom1 == obstacle_ || c.geom2 == obstacle_) {
-          s.min_clearance = std::min(s.min_clearance, c.dist);
-        }
-      }
-    }
-
-    // Constraints that can only get worse: obstacle clearance and forward pitch.
-    const TaskConstraints& c = task_.constraints;
-    decide_if((c.clearance && s.min_clearance < c.min_clearance) ||
-              (c.pitch && s.max_forward_pitch > c.max_pitch));
-    if (end_when_decided_ && decided_ >= 0 && s.landed) {
-      finish(t, d);
-      s.ended_decided = true;
-      s.rotation_total = 2 * M_PI * c.rotation_turns;
-      return true;
-    }
-
-    // A hop before the jump: off the ground in a phase before the extend.
-    if (task_.simulation.hop_is_fall && extend_ >= 0 && phase < extend_) {
-      if (contacts_.any) {
-        off_since_ = -1;
-      } else if (off_since_ < 0) {
-        off_since_ = t;
-      } else if (t - off_since_ >= 0.02 - 1e-9) {
-        return fall(t, "left the ground before the jump", d);
-      }
-    }
-
-    // Falls.
-    if (contacts_.non_foot) return fall(t, "a body other than the feet touched the ground or an object", d);
-    if (!airborne) {
-      const double feet_z = feet_mean(d, 2);
-      if (com_z - feet_z < task_.simulation.fall_com_height) {
-        return fall(t, "the centre of mass dropped to the feet", d);
-      }
-      if (task_.simulation.fall_tilt > 0 && tilt(d, pitch) > task_.simulation.fall_tilt) {
-        return fall(t, "the body tipped over", d);
-      }
-      // A topple: both feet down, past the landing's first topple_after seconds, and the
-      // COM and its capture point both topple_distance outside the soles.
-      const TaskSimulation& rules = task_.simulation;
-      if (rules.topple_distance > 0 && s.landed && contacts_.foot[0] && contacts_.foot[1] &&
-          t - controller_.phase_times().landing() >= rules.topple_after - 1e-9) {
-        const auto& x = controller_.com();
-        const auto& v = controller_.com_velocity();
-        const double g = std::max(1e-9, std::fabs(m->opt.gravity[2]));
-        const double tc = std::sqrt(std::max(0.0, x[2] - feet_z) / g);
-        const SoleOutline soles = sole_outline(m, d, body_, contacts_);
-        if (soles.margin({x[0], x[1]}) < -rules.topple_distance &&
-            soles.margin({x[0] + v[0] * tc, x[1] + v[1] * tc}) < -rules.topple_distance) {
-          // Ranked as the fall it would become: most topples lie on the ground a second
-          // or more after touch-down, where a fall's progress is full.
-          return fall(t, "toppled over the edge of the feet", d, /*landed_fully=*/true);
-        }
-      }
-    }
-
-    // End of the motion.
-    const TaskSimulation& sim = task_.simulation;
-    if (s.landed) {
-      const double since = t - controller_.phase_times().landing();
-      const auto& v = controller_.com_velocity();
-      // At rest: slow, and (balanced_rest) slow with the capture point over the feet for
-      // the last rest_hold seconds.
-      const bool slow = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) < sim.settle_speed;
-      bool rest = slow;
-      if (sim.balanced_rest) {
-        const bool still = slow && capture_point_margin(m, d, body_, controller_.com(), v) >= 0;
-        if (!still) {
-          still_since_ = -1;
-        } else if (still_since_ < 0) {
-          still_since_ = t;
-        }
-        rest = still && t - still_since_ >= sim.rest_hold - 0.5 * m->opt.timestep;
-      }
-      if (since >= sim.settle_time && rest) {
-        s.settled = true;
-        return finish(t, d);
-      }
-      if (since >= sim.settle_max) return fall(t, "did not come to rest after landing", d);
-    }
-    if (t + m->opt.timestep > sim.max_time) {
-      return fall(t, s.took_off ? "did not land in time" : "never left the ground", d);
-    }
-    return false;
-  }
-
- private:
-  // How far the motion got: the phase reached, then the time at rest after landing.
-  double progress(double t) const {
-    const int phase = controller_.phase();
-    const double phases = static_cast<double>(controller_.phase_times().begin.size());
-    if (phase == land_ && out_.summary.landed) {
-      const double since = t - controller_.phase_times().landing();
-      return (land_ + std::min(1.0, since / task_.simulation.settle_time)) / phases;
-    }
-    return static_cast<double>(std::min(phase, land_)) / phases;
-  }
-
-  // The root's forward pitch from standing (rad, positive forward): the planar root's
-  // hinge (positive backwards), or a free root's forward axis's elevation below standing.
-  double forward_pitch(const mjData* d, double pitch) const {
-    if (body_.root == RootKind::kPlanar) return -(pitch - pitch0_);
-    double w[3];
-    mju_mulMatVec(w, d->xmat + 9 * body_.root_body, fwd0_, 3, 3);
-    return elevation0_ - std::atan2(w[2], std::hypot(w[0], w[1]));
-  }
-
-  // The root's tilt from standing upright (rad).
-  double tilt(const mjData* d, double pitch) const {
-    if (body_.root == RootKind::kPlanar) return std::fabs(pitch - pitch0_);
-    double up[3];
-    mju_mulMatVec(up, d->xmat + 9 * body_.root_body, up0_, 3, 3);
-    return std::acos(std::clamp(up[2], -1.0, 1.0));
-  }
-
-  // Mean over the two feet's centres of mass of world coordinate `axis` (0 = x, 2 = z).
-  double feet_mean(const mjData* d, int axis) const {
-    return 0.5 * (d->xipos[3 * body_.feet[0] + axis] + d->xipos[3 * body_.feet[1] + axis]);
-  }
-
-  // The root's pitch (rad, positive backwards), unwrapped over the motion: the planar
-  // root's hinge angle, or for a free root the integral of its world angular velocity
-  // about -y (a full backward turn gives 2 pi).
-  double root_pitch(const mjModel* m, const mjData* d) {
-    if (body_.root == RootKind::kPlanar) return d->qpos[body_.root_pitch_qpos];
-    if (!first_) {
-      const double* w = d->qvel + body_.root_dof + 3;  // body frame
-      const double* R = d->xmat + 9 * body_.root_body;
-      const double wy = R[3] * w[0] + R[4] * w[1] + R[5] * w[2];
-      free_pitch_ += -wy * m->opt.timestep;
-    }
-    return free_pitch_;
-  }
-
-  // `landed_fully`: the fall's progress is that of a fall settle_time or more after
-  // touch-down, whenever it is called.
-  bool fall(double t, const char* why, const mjData* d, bool landed_fully = false) {
-    MotionSummary& s = out_.summary;
-    s.fell = true;
-    s.fall_reason = why;
-    s.fall_progress = landed_fully ? (land_ + 1.0) / static_cast<double>(controller_.phase_times().begin.size())
-                                   : progress(t);
-    return finish(t, d);
-  }
-
-  bool finish(double t, const mjData* d) {
-    MotionSummary& s = out_.summary;
-    s.end_time = t;
-    s.feet_x = feet_mean(d, 0);
-    s.feet_y = feet_mean(d, 1);
-    s.feet_z = feet_mean(d, 2);
-    if (!s.landed) {  // never touched down: the end position stands for both
-      s.touchdown_feet_x = s.feet_x;
-      s.touchdown_feet_y = s.feet_y;
-      s.touchdown_feet_z = s.feet_z;
-    }
-    s.rotation_total = last_pitch_ - pitch0_;
-    return true;
-  }
-
-  const Task& task_;
-  const Character& body_;
-  Controller& controller_;
-  JointDrive& drive_;
-  int obstacle_;
-  bool end_when_decided_;
-  Evaluation& out_;
-  const int rise_, fall_, land_;  // the controller's airborne phases and landing
-  const int extend_;              // its push-off phase (-1: none)
-  ContactState contacts_;
-  double off_since_ = -1;   // before the extend: time the last contact was lost, -1 if touching
-  void decide_if(bool cannot_meet) {
-    if (cannot_meet && decided_ < 0) decided_ = index_;
-  }
-
-  bool first_ = true;
-  double still_since_ = -1;  // s: slow and balanced since then, without a break (-1: not now)
-  long index_ = 0, decided_ = -1;  // steps observed; when the outcome was decided
-  double pitch0_ = 0, pitch_takeoff_ = 0, last_pitch_ = 0, free_pitch_ = 0;
-  double up0_[3] = {0, 0, 1}, fwd0_[3] = {1, 0, 0};  // free root: standing axes in its frame
-  double elevation0_ = 0;                            // rad, the standing forward axis's
-};
 
 // Puts the worker's geom friction back to the shared model's when it goes out of scope.
 class FrictionRestore {
@@ -328,40 +66,38 @@ class PushHooks : public StepHooks {
   Evaluation& out_;
 };
 
-// A rollout's hooks that also measure its foot slip (TaskConstraints::foot_slip), step by
-// step as a replay of its record would (task/foot_slip.h); without a meter they only
-// forward.
-class MeteredHooks : public StepHooks {
+// A rollout's hooks that also tell the listed constraints' observers of every simulation
+// step (RolloutTerms::stepped; a foot-slip bound's meter), as a replay of its record would.
+class TermHooks : public StepHooks {
  public:
-  MeteredHooks(StepHooks& inner, FootSlipMeter* meter) : inner_(inner), meter_(meter) {}
+  TermHooks(StepHooks& inner, RolloutTerms& terms) : inner_(inner), terms_(terms) {}
   void control(mjModel* m, mjData* d) override { inner_.control(m, d); }
   bool observe(const mjModel* m, const mjData* d) override { return inner_.observe(m, d); }
   void stepped(const mjModel* m, const mjData* d) override {
-    if (meter_ != nullptr) meter_->after_step(m, d);
+    terms_.stepped(m, d);
     inner_.stepped(m, d);
   }
 
  private:
   StepHooks& inner_;
-  FootSlipMeter* meter_;
+  RolloutTerms& terms_;
 };
 
 // Runs a rollout with a task's hooks (under the suite's push, if any) and fills in what
-// every kind of task reports of it: the rollout's stats, phases and failure, C, and when
-// the outcome was decided (Hooks: JumpHooks or WalkObserver).
-template <class Hooks>
+// every kind of task reports of it: the rollout's stats, phases and failure, what the
+// listed constraints measured, C, when the outcome was decided, and the pose samples
+// (hooks: a JumpObserver or a WalkObserver).
 void simulate(const Task& task, const Character& body, const Controller& controller, JointDrive& drive,
-              Hooks& hooks, int max_steps, SimWorker& worker, const EvaluationOptions& options, Evaluation& e) {
-  std::optional<FootSlipMeter> meter;
-  if (task.constraints.foot_slip) meter.emplace(worker.model(), foot_geom_sides(worker.model(), body));
-  MeteredHooks metered(hooks, meter ? &*meter : nullptr);
+              TaskObserver& hooks, RolloutTerms& terms, int max_steps, SimWorker& worker,
+              const EvaluationOptions& options, Evaluation& e) {
+  TermHooks observed(hooks, terms);
   if (options.push.time >= 0) {
-    PushHooks pushed(metered, body, options.push, e);
+    PushHooks pushed(observed, body, options.push, e);
     e.stats = run_rollout(worker, pushed, max_steps, drive, options.recorder);
   } else {
-    e.stats = run_rollout(worker, metered, max_steps, drive, options.recorder);
+    e.stats = run_rollout(worker, observed, max_steps, drive, options.recorder);
   }
-  if (meter) e.summary.foot_slip = meter->finish().largest();
+  terms.finish(e.summary);
   e.phases = controller.phase_times();
   if (e.stats.unstable) {
     e.failed = true;
@@ -374,6 +110,7 @@ void simulate(const Task& task, const Character& body, const Controller& control
   e.decided_step = static_cast<int>(hooks.decided_at());
   if (hooks.decided_at() >= 0)
     e.steps_after_decided = static_cast<int>(std::max(0L, hooks.observed() - hooks.decided_at()));
+  if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);
 }
 
 }  // namespace
@@ -386,9 +123,6 @@ TaskEvaluator::TaskEvaluator(Task task) : task_(std::move(task)) {
   check_scene(task_, model_->get(), *body_);
   task_.controller_type->check(*body_, *task_.controller_config, task_.file);
   specs_ = task_.controller_type->parameter_specs(*body_, *task_.controller_config);
-  if (task_.constraints.clearance) {
-    obstacle_geom_ = mj_name2id(model_->get(), mjOBJ_GEOM, task_.constraints.clearance_object.c_str());
-  }
 }
 
 void TaskEvaluator::check_strength() const {
@@ -524,19 +258,10 @@ Evaluation TaskEvaluator::evaluate_jump(Controller& controller, JointDrive& driv
   mjModel* m = worker.model();
   e.flight_time.reserve(1024);
   e.flight_qpos.reserve(1024 * static_cast<size_t>(m->nq));
-  JumpHooks hooks(task_, body, controller, drive, obstacle_geom_, options.end_when_decided, e);
+  RolloutTerms terms(task_, m, body);
+  JumpObserver hooks(task_, body, m, controller, drive, terms, options.samples_per_phase, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.simulation.max_time / m->opt.timestep)) + 1;
-  simulate(task_, body, controller, drive, hooks, max_steps, worker, options, e);
-  if (!e.failed && options.samples_per_phase > 0 && e.has_flight() && e.summary.landed) {
-    std::vector<double> taus;
-    for (int k = 0; k < options.samples_per_phase; ++k) {
-      taus.push_back((k + 0.5) / options.samples_per_phase);
-    }
-    for (int phase = 0; phase < 2; ++phase) {
-      auto poses = sample_poses(e, phase, taus, worker);
-      e.poses.insert(e.poses.end(), poses.begin(), poses.end());
-    }
-  }
+  simulate(task_, body, controller, drive, hooks, terms, max_steps, worker, options, e);
   return e;
 }
 
@@ -544,10 +269,10 @@ Evaluation TaskEvaluator::evaluate_walk(Controller& controller, JointDrive& driv
                                         SimWorker& worker, const EvaluationOptions& options) const {
   Evaluation e;
   mjModel* m = worker.model();
-  WalkObserver hooks(task_, body, m, controller, drive, options.samples_per_phase, options.end_when_decided, e);
+  RolloutTerms terms(task_, m, body);
+  WalkObserver hooks(task_, body, m, controller, drive, terms, options.samples_per_phase, options.end_when_decided, e);
   const int max_steps = static_cast<int>(std::ceil(task_.walk.max_time / m->opt.timestep)) + 1;
-  simulate(task_, body, controller, drive, hooks, max_steps, worker, options, e);
-  if (!e.failed && options.samples_per_phase > 0) e.poses = hooks.poses(worker);
+  simulate(task_, body, controller, drive, hooks, terms, max_steps, worker, options, e);
   return e;
 }
 
@@ -684,43 +409,7 @@ Evaluation TaskEvaluator::evaluate_named(const ParameterSet& params, const Evalu
 std::vector<PoseSample> TaskEvaluator::sample_poses(const Evaluation& e, int phase,
                                                     const std::vector<double>& taus,
                                                     SimWorker& worker) const {
-  if (!e.has_flight() || e.flight_time.empty()) {
-    throw std::logic_error("sample_poses: the evaluation has no flight");
-  }
-  const mjModel* m = worker.model();
-  mjData* d = worker.data();
-  const int nq = m->nq;
-  const double a = phase == 0 ? e.phases.takeoff() : e.phases.peak();
-  const double b = phase == 0 ? e.phases.peak() : e.phases.landing();
-  std::vector<PoseSample> out;
-  for (double tau : taus) {
-    const double t = a + std::clamp(tau, 0.0, 1.0) * (b - a);
-    // Bracketing recorded states; linear interpolation (hinges and slides; a free root's
-    // quaternion is interpolated linearly and normalized, exact enough between two steps).
-    const auto& ts = e.flight_time;
-    size_t hi = std::lower_bound(ts.begin(), ts.end(), t) - ts.begin();
-    hi = std::min(hi, ts.size() - 1);
-    const size_t lo = hi > 0 ? hi - 1 : 0;
-    const double w = (hi == lo || ts[hi] == ts[lo]) ? 1.0 : std::clamp((t - ts[lo]) / (ts[hi] - ts[lo]), 0.0, 1.0);
-    for (int i = 0; i < nq; ++i) {
-      d->qpos[i] = (1 - w) * e.flight_qpos[lo * nq + i] + w * e.flight_qpos[hi * nq + i];
-    }
-    if (body_->root == RootKind::kFree) mju_normalize4(d->qpos + body_->root_qpos + 3);
-    mj_kinematics(m, d);
-    PoseSample p;
-    p.phase = phase;
-    p.phase_time = tau;
-    p.time = t;
-    p.link_com.resize(3, static_cast<int>(body_->links.size()));
-    for (size_t k = 0; k < body_->links.size(); ++k) {
-      for (int c = 0; c < 3; ++c) p.link_com(c, static_cast<int>(k)) = d->xipos[3 * body_->links[k] + c];
-    }
-    p.angles.resize(static_cast<int>(body_->joints.size()));
-    for (size_t k = 0; k < body_->joints.size(); ++k) p.angles[static_cast<int>(k)] = d->qpos[body_->joints[k].qpos];
-    p.root = root_orientation(*body_, d->qpos);
-    out.push_back(std::move(p));
-  }
-  return out;
+  return flight_poses(*body_, e, phase, taus, worker);
 }
 
 Eigen::VectorXd TaskEvaluator::link_masses() const {

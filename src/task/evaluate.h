@@ -8,9 +8,12 @@
 // the same result bit for bit on any worker.
 //
 // The rollout stops as soon as the outcome is decided: a fall (any contact of a body
-// other than the feet with the ground or an object, or the COM within fall_com_height of
-// the feet), the character at rest settle_time after landing, or a time cap. A rollout
-// that blows up is a failed evaluation with a large penalty, never an exception.
+// other than the feet, and those constraints.allow_contact lists, with the ground or an
+// object, or the COM within fall_com_height of the feet), the character at rest
+// settle_time after landing, or a time cap. A rollout that blows up is a failed
+// evaluation with a large penalty, never an exception. A jump's rollout is watched by
+// JumpObserver (task/jump_eval.h), a walk's by its twin WalkObserver (task/walk_eval.h);
+// both give the listed constraints what they measure through task/rollout_terms.h.
 //
 // Pose samples for the distance metrics (paper section 4, SPEC 2.3): the airborne
 // states are recorded every step from take-off to landing, so poses can be sampled at any
@@ -213,7 +216,6 @@ class TaskEvaluator {
   std::shared_ptr<const SharedModel> model_;
   std::unique_ptr<Character> body_;
   std::vector<ParamSpec> specs_;  // the controller's parameters for body_, named once
-  int obstacle_geom_ = -1;
 
   // With a strength other than 1: every driven joint's limit is the strength times its
   // limit at strength 1; throws UserError naming an actuator whose limit did not scale.

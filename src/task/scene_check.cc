@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/toml_reader.h"
+#include "task/term_fall.h"
 
 namespace diverse {
 namespace {
@@ -63,35 +64,21 @@ void check_start_pose(const Task& task, const mjModel* m, const Character& body)
 void check_constraints(const Task& task) {
   const TaskConstraints& c = task.constraints;
   const TaskSimulation& s = task.simulation;
+  for (const auto& term : c.terms) term->check(task);
   // Where the feet may end: the intersection of every landing constraint's x interval.
   double lo = -INFINITY, hi = INFINITY;
   std::string fields;
-  auto narrow = [&](double a, double b, const std::string& field) {
-    lo = std::max(lo, a);
-    hi = std::min(hi, b);
-    fields += (fields.empty() ? "" : ", ") + field;
-  };
-  if (c.on_box) {
-    const SceneObject* box = task.find_object(c.on_box_object);
-    const double width = box->x_max - box->x_min;
-    if (!(2 * c.on_box_margin < width))
-      throw_field_error(task.file, "constraints.on_box.margin",
-                        "expected less than half the width of \"" + box->name + "\" (" + num(width) +
-                            " m wide), got " + num(c.on_box_margin) + " m: no spot on it is that far from both edges");
-    narrow(box->x_min + c.on_box_margin, box->x_max - c.on_box_margin, "constraints.on_box");
+  for (const auto& term : c.terms) {
+    const auto range = term->feet_x_range(task);
+    if (!range) continue;
+    lo = std::max(lo, range->first);
+    hi = std::min(hi, range->second);
+    fields += (fields.empty() ? "" : ", ") + term->field();
   }
-  if (c.landing)
-    narrow(c.landing_center - c.landing_half_width, c.landing_center + c.landing_half_width,
-           "constraints.landing");
-  if (c.min_length) narrow(c.min_length_value, INFINITY, "constraints.min_length");
   if (lo > hi)
     throw_field_error(task.file, fields,
                       "expected landing constraints that some x satisfies, but they leave nowhere to "
                       "land (the feet would need x >= " + num(lo) + " and x <= " + num(hi) + ")");
-  if (c.clearance && !(c.min_clearance < s.clearance_range))
-    throw_field_error(task.file, "constraints.clearance.min_clearance",
-                      "expected less than simulation.clearance_range (" + num(s.clearance_range) +
-                          " m, the distance up to which proximity is seen), got " + num(c.min_clearance));
   if (!(s.max_time > s.settle_time))
     throw_field_error(task.file, "simulation.max_time",
                       "expected more than simulation.settle_time (" + num(s.settle_time) +
@@ -103,6 +90,7 @@ void check_constraints(const Task& task) {
 void check_scene(const Task& task, const mjModel* m, const Character& body) {
   check_physics(task, m);
   check_constraints(task);
+  allowed_contact_bodies(m, body, task.constraints, task.file);  // names bodies of the character
   check_start_pose(task, m, body);
 }
 

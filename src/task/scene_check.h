@@ -17,7 +17,9 @@
 //                of the on_box object and min_length share some x; an obstacle's
 //                min_clearance is below simulation.clearance_range (proximity beyond it
 //                is not seen); simulation.max_time leaves room to settle_time after a
-//                landing
+//                landing; every constraint's own check (task/term.h, Constraint::check)
+//   contacts     constraints.allow_contact names bodies of the character, or "hands" of a
+//                character that has hands
 #pragma once
 
 #include <mujoco/mujoco.h>

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "task/term_landing.h"
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/thread_pool.h"
@@ -279,7 +280,7 @@ Task with_height(const Task& task, double height) {
 // The task with its landing constraint's centre at `x`.
 Task with_distance(const Task& task, double x) {
   Task t = task;
-  t.constraints.landing_center = x;
+  t.constraints.change<LandingConstraint>([x](LandingConstraint& landing) { landing.center = x; });
   return t;
 }
 

@@ -1,5 +1,6 @@
 #include "task/task.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,8 @@
 #include "core/error.h"
 #include "core/text_file.h"
 #include "core/toml_reader.h"
+#include "task/term_fall.h"
+#include "task/term_landing.h"
 
 namespace diverse {
 namespace fs = std::filesystem;
@@ -82,98 +85,49 @@ void read_objects(const TomlReader& r, const toml::node* node, Task& task) {
   }
 }
 
-void require_object(const TomlReader& r, const Task& task, const char* key, const std::string& name,
-                    const char* kind) {
-  const SceneObject* obj = task.find_object(name);
-  if (obj == nullptr || obj->kind != kind) {
-    r.fail(key, std::string("expected the name of an object of kind \"") + kind + "\", got \"" +
-                    name + "\"");
+// Reads one constraint of `kind` from `r` (its keys only) into the task's constraints.
+void read_term(const ConstraintKind& kind, const TomlReader& r, Task& task, bool walks) {
+  if (walks && !kind.walks) {
+    std::string known;
+    for (const ConstraintKind& k : builtin_constraint_kinds())
+      if (k.walks) known += std::string(known.empty() ? "" : ", ") + k.name;
+    throw UserError(r.file() + ": " + r.path() + ": expected a constraint a walk can meet (" + known +
+                    "), got \"" + kind.name + "\"");
   }
+  kind.read(r, task, task.constraints);
 }
 
-void read_constraints(const TomlReader& r, Task& task) {
-  r.only({"weight", "fall_penalty", "landing", "on_box", "clearance", "min_length",
+// The table form: [constraints] with one table per constraint, in the order their terms
+// add to C.
+void read_constraint_table(const TomlReader& r, Task& task, bool walks) {
+  r.only({"weight", "fall_penalty", "allow_contact", "landing", "on_box", "clearance", "min_length",
           "peak_height", "rotation", "pitch", "half_timestep", "foot_slip"});
   TaskConstraints& c = task.constraints;
   c.weight = r.number("weight", 1e-6, 1e9);
   c.fall_penalty = r.number("fall_penalty", 1e-6, 1e12);
-  if (auto t = r.table("landing", false)) {
-    TomlReader s = r.sub("landing", *t);
-    s.only({"center", "half_width", "lateral", "radius"});
-    c.landing = true;
-    c.landing_center = s.number("center", -20, 20);
-    if (s.has("radius")) {
-      if (s.has("half_width")) s.fail("radius", "expected either half_width (a box along x) or radius (a disc), not both");
-      c.landing_radius = s.number("radius", 0.001, 10);
-      c.landing_lateral = s.number("lateral", -20, 20, 0.0);
-    } else {
-      if (s.has("lateral")) s.fail("lateral", "expected lateral only with a radius (a disc)");
-      c.landing_half_width = s.number("half_width", 0.001, 10);
-    }
-  }
-  if (auto t = r.table("on_box", false)) {
-    TomlReader s = r.sub("on_box", *t);
-    s.only({"object", "margin"});
-    c.on_box = true;
-    c.on_box_object = s.string("object");
-    require_object(s, task, "object", c.on_box_object, "box");
-    c.on_box_margin = s.number("margin", 0, 5);
-  }
-  if (auto t = r.table("clearance", false)) {
-    TomlReader s = r.sub("clearance", *t);
-    s.only({"object", "min_clearance"});
-    c.clearance = true;
-    c.clearance_object = s.string("object");
-    require_object(s, task, "object", c.clearance_object, "obstacle");
-    c.min_clearance = s.number("min_clearance", 0, 1);
-  }
-  if (auto t = r.table("min_length", false)) {
-    TomlReader s = r.sub("min_length", *t);
-    s.only({"length"});
-    c.min_length = true;
-    c.min_length_value = s.number("length", -20, 20);
-  }
-  if (auto t = r.table("peak_height", false)) {
-    TomlReader s = r.sub("peak_height", *t);
-    s.only({"min", "above_standing"});
-    c.peak_height = true;
-    if (s.has("above_standing")) {
-      if (s.has("min")) s.fail("min", "expected either min (m above the floor) or above_standing (m above the standing COM), not both");
-      c.peak_height_relative = true;
-      c.peak_height_min = s.number("above_standing", 0, 5);
-    } else {
-      c.peak_height_min = s.number("min", 0, 5);
-    }
-  }
-  if (auto t = r.table("rotation", false)) {
-    TomlReader s = r.sub("rotation", *t);
-    s.only({"turns", "tolerance", "penalty", "min_flight"});
-    c.rotation = true;
-    c.rotation_turns = s.number("turns", -3, 3);
-    c.rotation_tolerance = s.number("tolerance", 0.01, 3.14);
-    c.rotation_penalty = s.number("penalty", 0, 1e12);
-    const double most = 2 * M_PI * std::fabs(c.rotation_turns) + c.rotation_tolerance;
-    c.min_flight_rotation = s.number("min_flight", 0, 20, 0.0);
-    if (c.min_flight_rotation > most) {
-      std::ostringstream what;
-      what << "expected a rotation in the air (rad) no larger than the whole turn allows, 2 pi |turns| + tolerance = "
-           << most << ", got " << c.min_flight_rotation;
-      s.fail("min_flight", what.str());
-    }
-  }
-  if (auto t = r.table("pitch", false)) {
-    TomlReader s = r.sub("pitch", *t);
-    s.only({"max"});
-    c.pitch = true;
-    c.max_pitch = s.number("max", 0.01, 3.14);
-  }
-  if (auto t = r.table("foot_slip", false)) {
-    TomlReader s = r.sub("foot_slip", *t);
-    s.only({"per_stance"});
-    c.foot_slip = true;
-    c.max_foot_slip = s.number("per_stance", 0, 1);
+  for (const char* name : {"landing", "on_box", "clearance", "min_length", "peak_height", "rotation", "pitch", "foot_slip"}) {
+    if (auto t = r.table(name, false)) read_term(find_constraint_kind(name, r.file()), r.sub(name, *t), task, walks);
   }
   c.half_timestep = r.boolean("half_timestep", false);
+  read_allow_contact(r, c);
+}
+
+// The list form: [[constraints]], one entry per constraint, `kind` and the kind's keys,
+// in the order their terms add to C.
+void read_constraint_list(const TomlReader& r, Task& task, bool walks) {
+  const std::vector<const toml::table*> entries = r.tables("constraints", true);
+  std::vector<std::string> seen;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const TomlReader e = r.element("constraints", i, *entries[i]);
+    const std::string name = e.string("kind");
+    const ConstraintKind& kind = find_constraint_kind(name, e.file() + ": " + e.field("kind"));
+    if (!kind.repeats && std::find(seen.begin(), seen.end(), name) != seen.end())
+      e.fail("kind", "expected each kind once, \"" + name + "\" is listed twice");
+    seen.push_back(name);
+    toml::table keys = *entries[i];
+    keys.erase("kind");
+    read_term(kind, e.with_table(keys), task, walks);
+  }
 }
 
 void read_simulation(const TomlReader& r, Task& task) {
@@ -259,10 +213,11 @@ void read_seed(const TomlReader& r, Task& task) {
       s.distances.push_back(v);
     }
     if (!s.object.empty()) r.fail("distances", "expected either an object's heights or landing distances, not both");
-    if (!task.constraints.landing) r.fail("distances", "expected a landing constraint to move (constraints.landing)");
-    if (s.distances.back() != task.constraints.landing_center) {
+    const LandingConstraint* landing = task.constraints.find<LandingConstraint>();
+    if (landing == nullptr) r.fail("distances", "expected a landing constraint to move (constraints.landing)");
+    if (s.distances.back() != landing->center) {
       r.fail("distances", "expected the last distance to be the task's landing centre (" +
-                              std::to_string(task.constraints.landing_center) + ")");
+                              std::to_string(landing->center) + ")");
     }
   }
   s.generations = static_cast<int>(r.integer("generations", 1, 100000, s.generations));
@@ -307,13 +262,18 @@ Task load_task(const std::string& path) {
   task.variations = static_cast<int>(r.integer("variations", 1, 100));
   task.m0 = resolve(path, r.string("m0"));
   read_controller(r.sub("controller", *r.table("controller", true)), task);
+  const bool walks = std::string(task.controller_type->skill(*task.controller_config)) == "walk";
   read_objects(r, root.get("objects"), task);
   if (auto t = r.table("simulation", false)) read_simulation(r.sub("simulation", *t), task);
-  read_constraints(r.sub("constraints", *r.table("constraints", true)), task);
+  // [constraints] (a table of constraints) or [[constraints]] (a list of them).
+  if (const toml::node* n = root.get("constraints"); n != nullptr && n->is_array()) {
+    read_constraint_list(r, task, walks);
+  } else {
+    read_constraint_table(r.sub("constraints", *r.table("constraints", true)), task, walks);
+  }
   if (auto t = r.table("seed", false)) read_seed(r.sub("seed", *t), task);
   if (auto t = r.table("diversity", false)) read_diversity(r.sub("diversity", *t), task);
   if (auto t = r.table("walk", false)) read_walk(r.sub("walk", *t), task.walk);
-  const bool walks = std::string(task.controller_type->skill(*task.controller_config)) == "walk";
   if (walks != task.walk.enabled) {
     r.fail("walk", walks ? "expected a [walk] table for the walk controller \"" + task.controller + "\" (missing)"
                          : "expected no [walk] table: the controller \"" + task.controller + "\" does not walk");

@@ -21,6 +21,7 @@
 
 #include "character/character.h"
 #include "control/controller.h"
+#include "task/term.h"
 #include "task/walk_task.h"
 
 namespace diverse {
@@ -36,55 +37,42 @@ struct SceneObject {
 };
 
 struct TaskConstraints {
-  double weight = 5000;           // K_c in C = K_c |d|^2 (SPEC 2.4)
+  double weight = 5000;           // K_c in C = K_c |d|^2 (SPEC 2.4), of every term that names none
   double fall_penalty = 100000;   // constant for a fall (doubles for the earliest falls)
-  // The landing constraints (landing, on_box, min_length) hold for the feet at the first
-  // touch-down after flight and at rest (see task/constraints.h).
-  // Landing box: feet (mean of the two foot centres) within center +- half_width (x); or,
-  // with a radius (3D characters), within `radius` of the point (center, lateral) in the
-  // ground plane (x, y).
-  bool landing = false;
-  double landing_center = 0, landing_half_width = 0.15;  // m
-  double landing_lateral = 0;                            // m, y of the landing point
-  double landing_radius = 0;                             // m; > 0: a disc instead of a box
-  // On top of a box object, at least `on_box_margin` from its edges.
-  bool on_box = false;
-  std::string on_box_object;
-  double on_box_margin = 0.1;  // m
-  // Clearance of an obstacle object: smallest body-obstacle distance >= min_clearance.
-  bool clearance = false;
-  std::string clearance_object;
-  double min_clearance = 0;  // m
-  // Minimum jump length: feet at x >= min_length.
-  bool min_length = false;
-  double min_length_value = 0;  // m
-  // Minimum peak height of the whole-body COM during flight: above the floor (`min`), or,
-  // with peak_height_relative (`above_standing`), above the COM's height in the start
-  // pose, so that a body with longer legs has to rise as far as any other.
-  bool peak_height = false;
-  double peak_height_min = 0;  // m
-  bool peak_height_relative = false;
-  // Root rotation from start to end within turns * 2 pi +- tolerance.
-  bool rotation = false;
-  double rotation_turns = 1;        // full turns, positive = backwards
-  double rotation_tolerance = 0.5;  // rad
-  double rotation_penalty = 100000; // constant added when violated
-  // The root turns at least this much (rad, in the direction of rotation_turns) between
-  // take-off and the first touch-down: a flip turns in the air, not on its feet. 0 = none.
-  double min_flight_rotation = 0;
+  // Bodies of the character whose contact with the ground or an object is not a fall (a
+  // handspring's or a cartwheel's hands): body names of its model, or "hands", the
+  // character file's [hands] bodies. Any other body that is not a foot touching
+  // something is still a fall.
+  std::vector<std::string> allow_contact;
+  std::string allow_contact_field;  // where the task file gives it, for messages
   // Every motion that meets the task is simulated again with the timestep halved and
   // meets it only if it still does there, its feet landing within kTimestepAgreement of
   // the same spot (task/constraints.h): a motion may not hinge on integration error.
   bool half_timestep = false;
-  // The root's forward pitch (rad, from standing, about the world's lateral axis) at most
-  // `max_pitch` throughout the motion (the bird robot's long jump).
-  bool pitch = false;
-  double max_pitch = 0;
-  // A planted foot slides at most `max_foot_slip` (m) in any one stance, measured in the
-  // rollout as task/foot_slip.h measures a replay (docs/reference/foot-slip.md): the
-  // largest stance's slide of either side, every stance of the motion counted.
-  bool foot_slip = false;
-  double max_foot_slip = 0.02;
+  // The constraints the task lists (task/term.h), in the order their terms add to C.
+  std::vector<std::shared_ptr<const Constraint>> terms;
+
+  // The first listed constraint of type T (task/term_*.h), or nullptr.
+  template <class T>
+  const T* find() const {
+    for (const auto& term : terms)
+      if (const T* t = dynamic_cast<const T*>(term.get())) return t;
+    return nullptr;
+  }
+  // Replaces the first listed constraint of type T by a copy changed by `how(T&)` (the
+  // input-motion search's continuation over the landing distance); false if none.
+  template <class T, class Change>
+  bool change(Change&& how) {
+    for (auto& term : terms) {
+      if (const T* t = dynamic_cast<const T*>(term.get())) {
+        auto changed = std::make_shared<T>(*t);
+        how(*changed);
+        term = std::move(changed);
+        return true;
+      }
+    }
+    return false;
+  }
 };
 
 struct TaskSimulation {

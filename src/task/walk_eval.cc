@@ -47,10 +47,9 @@ std::array<bool, 2> feet_on_ground(const mjModel* m, const mjData* d, const Char
 }  // namespace
 
 WalkObserver::WalkObserver(const Task& task, const Character& body, const mjModel* m,
-                           Controller& controller, JointDrive& drive, int samples, bool end_when_decided,
-                           Evaluation& out)
-    : task_(task), body_(body), controller_(controller), drive_(drive), samples_(samples),
-      end_when_decided_(end_when_decided), out_(out) {
+                           Controller& controller, JointDrive& drive, RolloutTerms& terms, int samples,
+                           bool end_when_decided, Evaluation& out)
+    : TaskObserver(task, body, controller, drive, terms, samples, end_when_decided, out) {
   nq_ = m->nq;
   const auto standing = standing_orientations(m);
   root_up_ = up_in(standing[static_cast<size_t>(body.root_body)]);
@@ -70,12 +69,6 @@ double WalkObserver::tilt(const mjData* d, int b, const std::array<double, 3>& u
   const double* R = d->xmat + 9 * b;
   const double z = R[6] * up[0] + R[7] * up[1] + R[8] * up[2];  // (R up) . world z
   return std::acos(std::clamp(z, -1.0, 1.0));
-}
-
-void WalkObserver::control(mjModel* m, mjData* d) {
-  contacts_ = scan_contacts(m, d, body_);
-  if (first_) controller_.reset(m, d);
-  controller_.control(m, d, contacts_, drive_);
 }
 
 bool WalkObserver::fall(const mjData* d, const char* why) {
@@ -224,8 +217,12 @@ bool WalkObserver::observe(const mjModel* m, const mjData* d) {
     return fall(d, "both feet were off the ground for longer than max_flight (a hop, not a walk)");
   }
 
+  // What the listed constraints measure themselves.
+  terms_.observe(m, d, s);
+
   // Falls.
-  if (contacts_.non_foot) return fall(d, "a body other than the feet touched the ground or an object");
+  if (contacts_.non_foot && terms_.contact_is_fall(m, d))
+    return fall(d, "a body other than the feet touched the ground or an object");
   const double feet_z = 0.5 * (d->xipos[3 * body_.feet[0] + 2] + d->xipos[3 * body_.feet[1] + 2]);
   if (controller_.com()[2] - feet_z < task_.simulation.fall_com_height) {
     return fall(d, "the centre of mass dropped to the feet");

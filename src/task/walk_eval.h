@@ -2,8 +2,10 @@
 // counts steps, measures each step's length in the heading frame and the pelvis and torso
 // tilt, detects falls, and ends the rollout as soon as the outcome is decided (a fall, or
 // the last step's touch-down). Steps are found from the feet's contacts, by the rule of
-// the walk audit (task/walk_audit.h), so the task and the audit count the same steps. TaskEvaluator (task/evaluate.h) uses it for every task
-// with a [walk] table.
+// the walk audit (task/walk_audit.h), so the task and the audit count the same steps.
+// TaskEvaluator (task/evaluate.h) uses it for every task with a [walk] table;
+// task/jump_eval.h is its twin for jumps. The constraints the task lists (a foot-slip
+// bound) measure through task/rollout_terms.h, as a jump's do.
 //
 // Pose samples (paper section 4.1): in every evaluated stride (the controller's strides
 // after its first settle_steps strike states; a stride is the four states left lift, left strike, right
@@ -28,29 +30,23 @@
 #include "physics/model.h"
 #include "physics/rollout.h"
 #include "task/evaluate.h"
+#include "task/rollout_terms.h"
 #include "task/task.h"
 
 namespace diverse {
 
-class WalkObserver : public StepHooks {
+class WalkObserver : public TaskObserver {
  public:
   // `m` is the model the rollout runs (standing orientations are read from it); `out`
-  // receives the summary (out.summary: fell, walk steps).
-  // With end_when_decided the walk ends at the step that first breaks the task's rules
-  // (EvaluationOptions::end_when_decided; MotionSummary::ended_decided).
+  // receives the summary (out.summary: fell, walk steps). With end_when_decided the walk
+  // ends at the step that first breaks the task's rules.
   WalkObserver(const Task& task, const Character& body, const mjModel* m, Controller& controller,
-               JointDrive& drive, int samples, bool end_when_decided, Evaluation& out);
+               JointDrive& drive, RolloutTerms& terms, int samples, bool end_when_decided, Evaluation& out);
 
-  void control(mjModel* m, mjData* d) override;
   bool observe(const mjModel* m, const mjData* d) override;
 
-  // The pose samples of the evaluated strides, after the rollout (uses worker's mjData
-  // as scratch). Empty unless the walk took all its steps.
-  std::vector<PoseSample> poses(SimWorker& worker) const;
-
-  // Steps observed, and when an evaluated step first broke the task's rules (-1: none).
-  long observed() const { return index_; }
-  long decided_at() const { return decided_; }
+  // The pose samples of the evaluated strides. Empty unless the walk took all its steps.
+  std::vector<PoseSample> poses(SimWorker& worker) const override;
 
  private:
   bool fall(const mjData* d, const char* why);
@@ -58,15 +54,6 @@ class WalkObserver : public StepHooks {
   double tilt(const mjData* d, int body, const std::array<double, 3>& up) const;
   void close_state(int state);           // samples of the state that just ended
 
-  const Task& task_;
-  const Character& body_;
-  Controller& controller_;
-  JointDrive& drive_;
-  int samples_;
-  bool end_when_decided_;
-  Evaluation& out_;
-  ContactState contacts_;
-  bool first_ = true;
   int torso_ = -1;                     // body tracked for uprightness besides the root, or -1
   std::array<double, 3> root_up_{0, 0, 1}, torso_up_{0, 0, 1};  // standing "up" in each body's frame
   double standing_heading_ = 0;
@@ -74,8 +61,6 @@ class WalkObserver : public StepHooks {
   double tilt_ = 0;                     // rad, largest since the last step
   double flight_start_ = -1;            // s, when both feet last left the ground; -1 if one is down
   // Steps from contacts.
-  long index_ = 0;                       // simulation steps observed
-  long decided_ = -1;                    // index_ when a step first broke the rules, or -1
   std::array<bool, 2> ground_{true, true};  // each foot on something not the character
   std::array<std::array<double, 2>, 2> footprint_{};  // m: each foot's body origin (x, y) at its last touch-down
   std::array<double, 2> lifted_{0, 0};   // s (index x timestep), when each foot last left it

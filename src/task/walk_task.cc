@@ -83,10 +83,8 @@ ConstraintReport walk_constraints(const Task& task, const MotionSummary& motion)
   add("step_lateral", std::sqrt(lateral), c.weight * lateral);
   add("upright", std::sqrt(tilt), c.weight * tilt);
   add("turn", turn, c.weight * turn * turn);
-  if (c.foot_slip) {
-    const double d = foot_slip_excess(c, motion);
-    add("foot_slip", d, c.weight * d * d);
-  }
+  // The constraints the task lists (a walk's: the foot slip).
+  for (const auto& term : c.terms) term->penalize(task, motion, report);
   // A walk ended at the step that first broke the rules (MotionSummary::ended_decided):
   // its evaluated steps so far stand for all of them, as a walk that has settled into its
   // gait repeats its steps, so their excesses count (evaluated steps) / (steps so far)
@@ -111,7 +109,7 @@ double walk_margin(const Task& task, const MotionSummary& motion) {
                        w.max_tilt_deg * kDeg - s.tilt});
   }
   margin = std::min(margin, w.max_turn_deg * kDeg - largest_turn(motion.walk));
-  margin = std::min(margin, foot_slip_margin(task.constraints, motion));
+  for (const auto& term : task.constraints.terms) margin = std::min(margin, term->margin(task, motion));
   return std::isfinite(margin) ? margin : -1;
 }
 

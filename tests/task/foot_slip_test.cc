@@ -19,6 +19,7 @@
 #include "support/task_variant.h"
 #include "task/evaluate.h"
 #include "task/task.h"
+#include "task/term_foot_slip.h"
 
 namespace diverse {
 namespace {
@@ -210,14 +211,14 @@ TEST(FootSlip, ACommittedInputMotionHasStancesOnBothSides) {
   EXPECT_DOUBLE_EQ(j["largest_per_stance"].get<double>(), slip.largest());
 }
 
-// The task's bound (TaskConstraints::foot_slip) measures the rollout step by step as the
+// The task's bound (task/term_foot_slip.h) measures the rollout step by step as the
 // replay measures its record: the same largest stance, to the last bit, and a term
 // "foot_slip" of K_c d^2 for the excess d only when the bound is broken.
 TEST(FootSlip, ATaskBoundMeasuresTheRolloutAsTheReplayDoes) {
   auto rollout = [](const std::string& name, const std::string& bound, StepRecorder* record) {
     const auto file = test_files::task_variant("jump_high", name, {"foot_slip ="}, {{"constraints", "foot_slip = { per_stance = " + bound + " }"}});
     const TaskEvaluator ev(load_task(file.string()));
-    EXPECT_TRUE(ev.task().constraints.foot_slip);
+    EXPECT_NE(ev.task().constraints.find<FootSlipConstraint>(), nullptr);
     EvaluationOptions options;
     options.samples_per_phase = 0;
     options.recorder = record;
@@ -245,12 +246,12 @@ TEST(FootSlip, ATaskBoundMeasuresTheRolloutAsTheReplayDoes) {
   };
   EXPECT_EQ(term(loose).penalty, 0);
   // The slack of the bound, for the input-motion search: the share left unused, as 10 cm.
-  TaskConstraints bound;
-  bound.foot_slip = true;
-  bound.max_foot_slip = 0.05;
-  EXPECT_NEAR(foot_slip_margin(bound, loose.summary), 0.1 * (1 - loose.summary.foot_slip / 0.05), 1e-15);
-  bound.foot_slip = false;
-  EXPECT_EQ(foot_slip_margin(bound, loose.summary), INFINITY);
+  const Task task;
+  FootSlipConstraint bound("constraints.foot_slip");
+  bound.per_stance = 0.05;
+  EXPECT_NEAR(bound.margin(task, loose.summary), 0.1 * (1 - loose.summary.foot_slip / 0.05), 1e-15);
+  bound.per_stance = 0;  // no slide allowed: no slack to keep away from
+  EXPECT_EQ(bound.margin(task, loose.summary), INFINITY);
   // A bound 1 mm below what the input motion slides: broken by 1 mm.
   std::ostringstream tight;
   tight.precision(17);

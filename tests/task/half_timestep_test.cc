@@ -18,6 +18,8 @@
 #include "eval/motion_problem.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
+#include "task/term_landing.h"
+#include "task/term_peak_height.h"
 
 namespace diverse {
 namespace {
@@ -160,7 +162,7 @@ TEST(HalfTimestep, TheOptimizersSamplesAreCheckedWhenConfirmed) {
 // above the standing COM) asks it to reach higher.
 TEST(HalfTimestep, StandingComMovesWithTheBody) {
   const Task task = load_task(kPaperFeet);
-  ASSERT_TRUE(task.constraints.peak_height_relative);
+  ASSERT_TRUE(task.constraints.find<PeakHeightConstraint>()->relative);
   const TaskEvaluator ev(task);
   auto worker = ev.make_worker();
   EvaluationOptions plain;
@@ -181,7 +183,7 @@ TEST(HalfTimestep, StandingComMovesWithTheBody) {
   const Evaluation tall = ev.evaluate(ev.control_values(ev.load_parameters(task.m0)), *scene, tall_worker, plain);
   EXPECT_GT(tall.summary.standing_com_z, m0.summary.standing_com_z + 0.1);
   // Whatever the tall body's jump did, its height is judged from where it stood.
-  const double required = task.constraints.peak_height_min + tall.summary.standing_com_z;
+  const double required = task.constraints.find<PeakHeightConstraint>()->min + tall.summary.standing_com_z;
   const ConstraintTerm* term = find_term(tall, "peak_height");
   ASSERT_NE(term, nullptr);
   EXPECT_NEAR(term->violation, std::max(0.0, required - tall.summary.peak_com_z), 1e-12);
@@ -297,7 +299,7 @@ TEST(DecidedOutcome, DecidedOnlyWhenTheTaskCanNoLongerBeMet) {
 
   // The landing box a metre further on: M0 lands short of it, decided at touch-down.
   Task task = load_task(kTasks + "jump_forward.toml");
-  task.constraints.landing_center += 1.0;
+  task.constraints.change<LandingConstraint>([](LandingConstraint& landing) { landing.center += 1.0; });
   const TaskEvaluator ev(task);
   auto worker = ev.make_worker();
   EvaluationOptions plain;

@@ -16,6 +16,9 @@
 #include "physics/drive.h"
 #include "task/evaluate.h"
 #include "task/seed_motion.h"
+#include "task/term_landing.h"
+#include "task/term_pitch.h"
+#include "task/term_rotation.h"
 
 namespace diverse {
 namespace {
@@ -165,14 +168,14 @@ TEST(M0Specifics, BackflipTurnsOverOnce) {
   // and 312 in flight, and comes to rest balanced 1 cm behind where it touched down, inside
   // the landing box.
   const Task task = load_task(kTasks + "backflip.toml");
-  EXPECT_NEAR(task.constraints.min_flight_rotation, 300 * M_PI / 180, 1e-3);
+  EXPECT_NEAR(task.constraints.find<RotationConstraint>()->min_flight, 300 * M_PI / 180, 1e-3);
   EXPECT_NEAR(r.e.summary.rotation_total, 2 * M_PI, 0.5);
   EXPECT_GE(r.e.summary.rotation_flight, 300 * M_PI / 180);
   EXPECT_TRUE(r.e.summary.settled);
   EXPECT_NEAR(r.e.summary.feet_x, r.e.summary.touchdown_feet_x, 0.2);
-  EXPECT_LE(std::fabs(r.e.summary.feet_x - task.constraints.landing_center), task.constraints.landing_half_width);
-  EXPECT_LE(std::fabs(r.e.summary.touchdown_feet_x - task.constraints.landing_center),
-            task.constraints.landing_half_width);
+  EXPECT_LE(std::fabs(r.e.summary.feet_x - task.constraints.find<LandingConstraint>()->center), task.constraints.find<LandingConstraint>()->half_width);
+  EXPECT_LE(std::fabs(r.e.summary.touchdown_feet_x - task.constraints.find<LandingConstraint>()->center),
+            task.constraints.find<LandingConstraint>()->half_width);
   // and at half the timestep it turns the same in the air
   const SimRun h = simulate("backflip", TaskEvaluator(task).model().get()->opt.timestep / 2);
   EXPECT_GE(h.e.summary.rotation_flight, 300 * M_PI / 180);
@@ -385,7 +388,7 @@ TEST(M0Specifics, RobotJumpGoesFourMetres) {
   const MotionSummary& s = r.e.summary;
   EXPECT_LT(std::hypot(s.touchdown_feet_x - 4.0, s.touchdown_feet_y), 0.75);
   EXPECT_LT(std::hypot(s.feet_x - 4.0, s.feet_y), 0.75);
-  EXPECT_LE(s.max_forward_pitch, load_task(kTasks + "robot_jump.toml").constraints.max_pitch);
+  EXPECT_LE(s.max_forward_pitch, load_task(kTasks + "robot_jump.toml").constraints.find<PitchConstraint>()->max);
 }
 
 // The strength-2 example (examples/strength2/, run with --strength 2) has an input motion

@@ -12,6 +12,11 @@
 #include "core/error.h"
 #include "task/constraints.h"
 #include "task/evaluate.h"
+#include "task/term_landing.h"
+#include "task/term_min_length.h"
+#include "task/term_peak_height.h"
+#include "task/term_pitch.h"
+#include "task/term_rotation.h"
 
 namespace diverse {
 namespace {
@@ -125,9 +130,9 @@ TEST_F(TaskFileTest, CommittedTasksParse) {
   EXPECT_DOUBLE_EQ(onto.find_object("box")->height, 0.5);
   const Task over = load_task(kTasks + "jump_over.toml");
   EXPECT_DOUBLE_EQ(over.find_object("obstacle")->height, 0.55);
-  EXPECT_TRUE(over.constraints.min_length);
-  EXPECT_TRUE(load_task(kTasks + "backflip.toml").constraints.rotation);
-  EXPECT_TRUE(load_task(kTasks + "jump_high.toml").constraints.peak_height);
+  EXPECT_NE(over.constraints.find<MinLengthConstraint>(), nullptr);
+  EXPECT_NE(load_task(kTasks + "backflip.toml").constraints.find<RotationConstraint>(), nullptr);
+  EXPECT_NE(load_task(kTasks + "jump_high.toml").constraints.find<PeakHeightConstraint>(), nullptr);
 }
 
 // The 3D tasks: a landing disc in the ground plane, the robot's pitch limit, falls by tilt,
@@ -137,16 +142,16 @@ TEST_F(TaskFileTest, ThreeDimensionalTasksParse) {
   EXPECT_EQ(back.controller_type->name(), std::string("skill"));
   EXPECT_EQ(back.controller_config->skill_name(), "jump3d");
   EXPECT_EQ(back.character_spec->name, "human3d");
-  EXPECT_DOUBLE_EQ(back.constraints.landing_center, -0.8);
-  EXPECT_DOUBLE_EQ(back.constraints.landing_lateral, 0.0);
-  EXPECT_DOUBLE_EQ(back.constraints.landing_radius, 0.25);
+  EXPECT_DOUBLE_EQ(back.constraints.find<LandingConstraint>()->center, -0.8);
+  EXPECT_DOUBLE_EQ(back.constraints.find<LandingConstraint>()->lateral, 0.0);
+  EXPECT_DOUBLE_EQ(back.constraints.find<LandingConstraint>()->radius, 0.25);
   EXPECT_DOUBLE_EQ(back.simulation.fall_tilt, 1.0);
-  EXPECT_FALSE(back.constraints.pitch);
+  EXPECT_EQ(back.constraints.find<PitchConstraint>(), nullptr);
   const Task robot = load_task(kTasks + "robot_jump.toml");
   EXPECT_EQ(robot.character_spec->name, "robot3d");
-  EXPECT_DOUBLE_EQ(robot.constraints.landing_radius, 0.75);
-  EXPECT_TRUE(robot.constraints.pitch);
-  EXPECT_DOUBLE_EQ(robot.constraints.max_pitch, 0.7);
+  EXPECT_DOUBLE_EQ(robot.constraints.find<LandingConstraint>()->radius, 0.75);
+  EXPECT_NE(robot.constraints.find<PitchConstraint>(), nullptr);
+  EXPECT_DOUBLE_EQ(robot.constraints.find<PitchConstraint>()->max, 0.7);
   EXPECT_EQ(robot.seed.distances, (std::vector<double>{2.0, 2.8, 3.5, 4.0}));
 }
 
@@ -154,8 +159,8 @@ TEST_F(TaskFileTest, LandingDiscAndPitchErrors) {
   const std::string disc = replace(valid_text(), "landing = { center = 1.0, half_width = 0.15 }",
                                    "landing = { center = 1.0, lateral = 0.2, radius = 0.3 }");
   const Task t = load_task(write(disc));
-  EXPECT_DOUBLE_EQ(t.constraints.landing_radius, 0.3);
-  EXPECT_DOUBLE_EQ(t.constraints.landing_lateral, 0.2);
+  EXPECT_DOUBLE_EQ(t.constraints.find<LandingConstraint>()->radius, 0.3);
+  EXPECT_DOUBLE_EQ(t.constraints.find<LandingConstraint>()->lateral, 0.2);
   EXPECT_EQ(error_of(replace(valid_text(), "half_width = 0.15", "half_width = 0.15, radius = 0.2")),
             ": constraints.landing.radius: expected either half_width (a box along x) or radius (a disc), not both");
   EXPECT_EQ(error_of(replace(valid_text(), "half_width = 0.15", "half_width = 0.15, lateral = 0.2")),
@@ -175,8 +180,8 @@ TEST_F(TaskFileTest, LandingDiscAndPitchErrors) {
 TEST_F(TaskFileTest, ValidTextParses) {
   const Task t = load_task(write(valid_text()));
   EXPECT_EQ(t.name, "t");
-  EXPECT_TRUE(t.constraints.landing);
-  EXPECT_DOUBLE_EQ(t.constraints.landing_center, 1.0);
+  EXPECT_NE(t.constraints.find<LandingConstraint>(), nullptr);
+  EXPECT_DOUBLE_EQ(t.constraints.find<LandingConstraint>()->center, 1.0);
   EXPECT_DOUBLE_EQ(t.simulation.settle_time, 1.0);
   EXPECT_DOUBLE_EQ(t.diversity.sigma0, 0.1);  // the default without a [diversity] table
   EXPECT_EQ(t.diversity.generations, 500);
@@ -318,7 +323,7 @@ TEST(Constraints, PenaltiesFollowSpec) {
 
   Task flip = load_task(kTasks + "backflip.toml");
   MotionSummary f;
-  f.feet_x = f.touchdown_feet_x = flip.constraints.landing_center;
+  f.feet_x = f.touchdown_feet_x = flip.constraints.find<LandingConstraint>()->center;
   f.rotation_total = 2 * M_PI - 0.4;  // within the 0.5 rad tolerance
   EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
   f.rotation_total = 2 * M_PI - 0.7;  // 0.2 rad beyond it
@@ -327,9 +332,9 @@ TEST(Constraints, PenaltiesFollowSpec) {
   // 0.1 rad less between take-off and touch-down pays 5000 (0.1)^2.
   f.rotation_total = 2 * M_PI;
   f.landed = true;
-  f.rotation_flight = flip.constraints.min_flight_rotation;
+  f.rotation_flight = flip.constraints.find<RotationConstraint>()->min_flight;
   EXPECT_EQ(evaluate_constraints(flip, f).total, 0.0);
-  f.rotation_flight = flip.constraints.min_flight_rotation - 0.1;
+  f.rotation_flight = flip.constraints.find<RotationConstraint>()->min_flight - 0.1;
   EXPECT_NEAR(evaluate_constraints(flip, f).total, 5000 * 0.01, 1e-6);
   f.landed = false;
   EXPECT_GT(constraint_margin(flip, MotionSummary{}), -2);  // defined everywhere
@@ -379,7 +384,7 @@ TEST(Constraints, LandingIsMeasuredAtTouchdownAndAtRest) {
 TEST_F(TaskFileTest, MinimumRotationInTheAir) {
   const std::string flip = valid_text() + "rotation = { turns = 1.0, tolerance = 0.5, penalty = 100000.0, min_flight = 5.0 }\n";
   const Task t = load_task(write(flip));
-  EXPECT_DOUBLE_EQ(t.constraints.min_flight_rotation, 5.0);
+  EXPECT_DOUBLE_EQ(t.constraints.find<RotationConstraint>()->min_flight, 5.0);
   MotionSummary m;
   m.took_off = m.landed = m.settled = true;
   m.feet_x = m.touchdown_feet_x = 1.0;
@@ -419,8 +424,8 @@ TEST_F(TaskFileTest, MinimumRotationInTheAir) {
 TEST_F(TaskFileTest, PeakHeightAboveTheStandingCom) {
   const Task absolute = load_task(write(valid_text() + "peak_height = { min = 1.2 }\n"));
   const Task relative = load_task(write(valid_text() + "peak_height = { above_standing = 0.3 }\n"));
-  EXPECT_FALSE(absolute.constraints.peak_height_relative);
-  EXPECT_TRUE(relative.constraints.peak_height_relative);
+  EXPECT_FALSE(absolute.constraints.find<PeakHeightConstraint>()->relative);
+  EXPECT_TRUE(relative.constraints.find<PeakHeightConstraint>()->relative);
   MotionSummary m;
   m.took_off = m.landed = m.settled = true;
   m.feet_x = m.touchdown_feet_x = 1.0;

@@ -19,6 +19,7 @@
 #include "task/evaluate.h"
 #include "task/task.h"
 #include "task/walk_audit.h"
+#include "task/term_foot_slip.h"
 #include "task/walk_task.h"
 
 namespace diverse {
@@ -344,8 +345,9 @@ TEST(WalkEvaluation, FromFootprintsTheStepsAreTheAuditsAndASlidingFootBreaksTheS
   ASSERT_FALSE(e.fell) << e.summary.fall_reason;
   // Its touch-downs, found from the contacts, are still steps backward.
   EXPECT_GT(e.constraint, 0);
-  task.constraints.foot_slip = true;
-  task.constraints.max_foot_slip = 0.02;
+  auto slip = std::make_shared<FootSlipConstraint>("constraints.foot_slip");
+  slip->per_stance = 0.02;
+  task.constraints.terms.push_back(slip);
   const TaskEvaluator bounded(task);
   const Evaluation f = evaluate_once(bounded, p);
   EXPECT_GT(f.summary.foot_slip, 0.1);
