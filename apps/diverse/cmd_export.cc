@@ -13,9 +13,9 @@
 #include "command.h"
 #include "options.h"
 #include "core/error.h"
+#include "finished/run_view.h"
 #include "io/bvh.h"
 #include "io/gltf.h"
-#include "render/run_media.h"
 
 namespace diverse::cli {
 namespace {

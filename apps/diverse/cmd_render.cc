@@ -11,6 +11,7 @@
 #include "command.h"
 #include "options.h"
 #include "core/error.h"
+#include "finished/run_view.h"
 #include "render/run_media.h"
 
 namespace diverse::cli {

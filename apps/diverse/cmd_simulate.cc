@@ -16,10 +16,10 @@
 #include "command.h"
 #include "options.h"
 #include "core/error.h"
+#include "finished/run_view.h"
 #include "io/motion_record.h"
 #include "render/film_strip.h"
 #include "render/film_columns.h"
-#include "render/run_media.h"
 #include "render/view_plan.h"
 #include "task/evaluate.h"
 

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "control/parameters.h"
 #include "eval/motion_problem.h"
+#include "params/parameters.h"
 #include "physics/rollout.h"
 #include "task/evaluate.h"
 

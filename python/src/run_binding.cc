@@ -1,10 +1,10 @@
-// Runs from Python (run/run.h with RunHooks) and finished runs read back (render/run_media.h).
+// Runs from Python (run/run.h with RunHooks) and finished runs read back (finished/run_view.h).
 #include <pybind11/stl.h>
 
 #include "binding.h"
 #include "core/error.h"
+#include "finished/run_view.h"
 #include "io/files.h"
-#include "render/run_media.h"
 #include "run/run.h"
 
 namespace diverse::python {

@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "character/character.h"
-#include "control/parameters.h"
+#include "params/parameters.h"
 #include "physics/model.h"
 
 namespace diverse {

@@ -8,7 +8,7 @@
 // the seam stays for a controller that cannot be written as one.
 //
 // A ControllerType parses its own keys, names and ranges its free parameters for a given
-// character (control/parameters.h), and makes one Controller per rollout. The task,
+// character (params/parameters.h), and makes one Controller per rollout. The task,
 // evaluation, run and render layers only see these interfaces: a new controller is a new
 // ControllerType in its own files under control/ plus one line in
 // control/builtin_controllers.cc, and touches nothing else.
@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "character/character.h"
-#include "control/parameters.h"
+#include "params/parameters.h"
 #include "physics/drive.h"
 
 namespace diverse {

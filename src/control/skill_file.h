@@ -15,7 +15,7 @@
 // peak, landing) and the events the film strip shows.
 //
 // Parameters. The optimizer varies the named parameters, each normalized to [0, 1] over
-// its range (control/parameters.h), in this order: phase by phase, the targets in the
+// its range (params/parameters.h), in this order: phase by phase, the targets in the
 // character's group order and then the gains (kp, kd) in the same order; then the phase
 // durations, phase by phase; then the modules' parameters, module by module, settings in
 // alphabetical order. A name used twice is one parameter (its ranges must agree).
@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "character/character.h"
-#include "control/parameters.h"
+#include "params/parameters.h"
 
 namespace diverse {
 

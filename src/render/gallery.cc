@@ -11,11 +11,12 @@
 #include "core/error.h"
 #include "core/thread_pool.h"
 #include "eval/motion_problem.h"
+#include "finished/run_problem.h"
 #include "io/files.h"
 #include "metric/metric.h"
 #include "task/evaluate.h"
 #include "task/task.h"
-#include "render/run_problem.h"
+#include "render/run_media.h"
 #include "render/view_plan.h"
 #include "robust/robustness.h"
 
@@ -556,7 +557,7 @@ nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options) {
   }
   nlohmann::json strips = nlohmann::json::array();
   // [x0, x1] along the track, or [x0, x1, y, radius] for a disc centred between x0 and x1.
-  for (const GroundStrip& g : run.ground_strips) {
+  for (const GroundStrip& g : run_ground_strips(run)) {
     if (g.radius > 0) {
       strips.push_back({round4(g.x_min), round4(g.x_max), round4(g.y), round4(g.radius)});
     } else {

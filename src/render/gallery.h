@@ -47,7 +47,7 @@
 #include <string>
 #include <vector>
 
-#include "render/run_media.h"
+#include "finished/run_view.h"
 
 namespace diverse {
 

@@ -62,8 +62,8 @@
 #include <string>
 #include <vector>
 
-#include "control/parameters.h"
 #include "core/thread_pool.h"
+#include "params/parameters.h"
 #include "task/evaluate.h"
 
 namespace diverse {

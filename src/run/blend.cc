@@ -11,10 +11,10 @@
 #include "core/rng.h"
 #include "core/thread_pool.h"
 #include "eval/motion_problem.h"
+#include "finished/run_problem.h"
+#include "finished/run_view.h"
 #include "io/files.h"
 #include "io/motion_record.h"
-#include "render/run_media.h"
-#include "render/run_problem.h"
 
 namespace diverse {
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 // the number of samples or threads, and more samples only add blends.
 //
 // Each blend is simulated with the run's task file exactly as the run simulated its
-// samples (render/run_problem.h): its constraint value C (0 when it meets the task) and
+// samples (finished/run_problem.h): its constraint value C (0 when it meets the task) and
 // its distance to each of the run's motions in the run's metric. For comparison, points
 // of every variation's optimization path (paths/m<i>.json: where it stood after its
 // steps, from M0 to its result; up to `path_points` per variation, evenly spaced) are
@@ -19,7 +19,7 @@
 //
 // RUN/blend/ (replaced as a whole by every `diverse blend`):
 //   summary.json        {"format": "diverse.blend", "version": 1, task, metric,
-//                        run_fingerprint (render/run_problem.h), seed,
+//                        run_fingerprint (finished/run_problem.h), seed,
 //                        samples (K), vertices (N + 1), labels ["M0", ...], vary,
 //                        feasible (count), feasible_fraction,
 //                        feasible_nearest_distance {mean, max} (feasible blends' distance

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/rng.h"
+#include "finished/run_view.h"
 #include "io/files.h"
 #include "io/motion_record.h"
 #include "physics/model.h"

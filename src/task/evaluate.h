@@ -30,7 +30,7 @@
 #include "character/character.h"
 #include "character/shape.h"
 #include "control/controller.h"
-#include "control/parameters.h"
+#include "params/parameters.h"
 #include "physics/model.h"
 #include "physics/rollout.h"
 #include "task/constraints.h"

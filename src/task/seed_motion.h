@@ -89,7 +89,7 @@
 #include <string>
 #include <vector>
 
-#include "control/parameters.h"
+#include "params/parameters.h"
 #include "task/constraints.h"
 #include "task/task.h"
 

@@ -16,7 +16,7 @@
 
 #include "character/character.h"
 #include "physics/drive.h"
-#include "control/parameters.h"
+#include "params/parameters.h"
 #include "control/skill_controller.h"
 #include "core/error.h"
 #include "physics/model.h"

@@ -24,10 +24,10 @@
 
 #include "character/character.h"
 #include "control/heading_frame.h"
-#include "control/parameters.h"
 #include "control/skill_controller.h"
 #include "core/error.h"
 #include "core/toml_reader.h"
+#include "params/parameters.h"
 #include "physics/drive.h"
 #include "physics/model.h"
 #include "physics/rollout.h"

@@ -12,7 +12,8 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
 for f in lib/libdiverse_core.a include/diverse/optimize/diversity.h include/diverse/optimize/cmaes.h \
-         include/diverse/metric/metric.h include/diverse/run/run.h lib/cmake/diverse/diverseConfig.cmake \
+         include/diverse/metric/metric.h include/diverse/run/run.h include/diverse/params/parameters.h \
+         include/diverse/finished/run_view.h include/diverse/finished/run_problem.h lib/cmake/diverse/diverseConfig.cmake \
          bin/diverse; do
   [ -e "$work/prefix/$f" ] || { echo "FAIL - installed $f"; exit 1; }
 done

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "finished/run_view.h"
 #include "physics/model.h"
 #include "render/film_columns.h"
 #include "render/film_strip.h"

@@ -5,10 +5,10 @@
 
 #include "character/character.h"
 #include "control/controller.h"
-#include "control/parameters.h"
 #include "control/stance_controller.h"
 #include "io/files.h"
 #include "io/motion_record.h"
+#include "params/parameters.h"
 #include "physics/drive.h"
 #include "task/task.h"
 

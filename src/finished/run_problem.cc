@@ -1,4 +1,4 @@
-#include "render/run_problem.h"
+#include "finished/run_problem.h"
 
 #include <algorithm>
 #include <cmath>

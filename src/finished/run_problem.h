@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "control/parameters.h"
 #include "eval/motion_problem.h"
-#include "render/run_media.h"
+#include "finished/run_view.h"
+#include "params/parameters.h"
 #include "task/evaluate.h"
 
 namespace diverse {

@@ -1,4 +1,4 @@
-#include "control/parameters.h"
+#include "params/parameters.h"
 
 #include <cmath>
 #include <sstream>
