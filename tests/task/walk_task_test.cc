@@ -153,7 +153,15 @@ TEST(WalkConstraints, RangesFallsAndTurns) {
     return s;
   };
   EXPECT_EQ(evaluate_constraints(task, walk_of(30, 1.0, 0.2, 5, 0)).total, 0);
-  EXPECT_NEAR(constraint_margin(task, walk_of(30, 1.0, 0.2, 5, 0)), 10 * M_PI / 180, 1e-12);  // the tilt's
+  // The margin is the smallest slack of any term: the tilt's 10 degrees, or the foot-slip
+  // bound's share left unused, counted as 0.1 m for all of it (task/term_foot_slip.h).
+  MotionSummary planted = walk_of(30, 1.0, 0.2, 5, 0);
+  planted.foot_slip = 0.0;  // 0.1 of slack
+  EXPECT_NEAR(constraint_margin(task, planted), 0.1, 1e-12);
+  planted.foot_slip = 0.015;  // half the 3 cm bound: 0.05
+  EXPECT_NEAR(constraint_margin(task, planted), 0.05, 1e-12);
+  MotionSummary tilted = walk_of(30, 1.0, 0.2, 12, 0);  // 3 degrees of tilt left
+  EXPECT_NEAR(constraint_margin(task, tilted), 3 * M_PI / 180, 1e-12);
   // Every evaluated step 0.2 m short: 20 steps of K 0.2^2; the settling steps do not count.
   MotionSummary short_steps = walk_of(30, 0.3, 0.2, 5, 0);
   for (int i = 0; i < 10; ++i) short_steps.walk.steps[static_cast<size_t>(i)].forward = -3;
