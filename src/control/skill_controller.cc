@@ -10,6 +10,7 @@
 #include "control/module_foot_placement.h"
 #include "control/module_gravity_compensation.h"
 #include "control/module_root_damping.h"
+#include "control/module_linear_feedback.h"
 #include "control/module_simbicon.h"
 #include "control/module_spotting.h"
 #include "control/module_stance.h"
@@ -445,16 +446,7 @@ bool SkillController::holds(const SkillCondition& c, const mjModel* m, const mjD
     case T::kFeature: break;
   }
   // A feature crossing a threshold.
-  using F = SkillCondition::Feature;
-  double v = 0;
-  switch (c.which) {
-    case F::kComX: v = state_.com[0]; break;
-    case F::kComZ: v = state_.com[2]; break;
-    case F::kComVx: v = state_.com_vel[0]; break;
-    case F::kComVz: v = state_.com_vel[2]; break;
-    case F::kPitch: v = state_.qpos[body_.root_pitch_qpos]; break;
-    case F::kPitchRate: v = d->qvel[body_.root_pitch_dof]; break;
-  }
+  const double v = skill_feature(c.which, body_, m, d, state_.com, state_.com_vel);
   return c.above ? v >= c.threshold : v <= c.threshold;
 }
 
@@ -634,6 +626,7 @@ std::unique_ptr<SkillModule> make_skill_module(const SkillModuleSpec& spec, cons
   if (spec.kind == "stance3d") return std::make_unique<Stance3dModule>(settings, body);
   if (spec.kind == "aim_legs") return std::make_unique<AimLegsModule>(settings, body);
   if (spec.kind == "root_damping") return std::make_unique<RootDampingModule>(settings, body);
+  if (spec.kind == "linear_feedback") return std::make_unique<LinearFeedbackModule>(spec, settings, body);
   throw std::logic_error("skill: no module of kind " + spec.kind);
 }
 

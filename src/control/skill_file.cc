@@ -205,7 +205,6 @@ void read_gain_set(const TomlReader& sets, const std::string& name, const toml::
 const std::vector<std::string> kConditions = {"duration", "time",         "contact",      "touchdown",
                                               "liftoff",  "contact_made", "contact_lost", "peak",
                                               "turned",   "spotted",      "feature"};
-const std::vector<std::string> kFeatures = {"com_x", "com_z", "com_vx", "com_vz", "pitch", "pitch_rate"};
 
 SkillCondition::Type condition_type(const std::string& kind) {
   using T = SkillCondition::Type;
@@ -276,8 +275,8 @@ SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
     } else if (kind == "feature") {
       need("feature");
       c.feature = r.string("feature");
-      if (std::find(kFeatures.begin(), kFeatures.end(), c.feature) == kFeatures.end()) {
-        r.fail("feature", "expected one of " + quoted_list(kFeatures) + ", got \"" + c.feature + "\"");
+      if (!skill_feature_of(c.feature, &c.which)) {
+        r.fail("feature", "expected one of " + quoted_list(skill_feature_names()) + ", got \"" + c.feature + "\"");
       }
       if (r.has("above") == r.has("below")) r.fail("above", "expected exactly one of above = NUMBER or below = NUMBER");
       c.above = r.has("above");
@@ -285,8 +284,6 @@ SkillTransition read_transition(const TomlReader& r, const toml::table& t) {
       used.insert(c.above ? "above" : "below");
     }
     c.type = condition_type(c.kind);
-    c.which = static_cast<SkillCondition::Feature>(
-        std::max<std::ptrdiff_t>(0, std::find(kFeatures.begin(), kFeatures.end(), c.feature) - kFeatures.begin()));
     tr.on.push_back(c);
   }
   for (const char* key : {"after", "for", "angle", "body", "foot", "feature", "above", "below"}) {
@@ -331,6 +328,9 @@ void check_setting(const TomlReader& r, const std::string& key, double v) {
   if (key == "stand_duration") lo = 0.05;
   if (key == "at_touchdown" || key == "push" || key == "take_footing") hi = 1;
   if (key == "turn") hi = 8 * M_PI;
+  if (key == "gain" || key == "reference") lo = -1e9;
+  if (key == "sample") hi = 1;
+  if (key == "limit") lo = 1e-6;
   if (!(v >= lo && v <= hi)) r.fail(key, "expected a number in [" + num(lo) + ", " + num(hi) + "], got " + num(v));
 }
 
@@ -361,6 +361,10 @@ const std::vector<SkillModuleKind>& skill_module_kinds() {
        "landing of a free root: the hips point each leg where the COM comes down (paper section 6)"},
       {"root_damping", {"kd"}, {},
        "push-off turn damping: the hip hinges damp the root's rotation about their axes"},
+      {"linear_feedback", {"gain"}, {"reference", "limit", "sample"},
+       "linear feedback: the targets of `target`'s joints offset by gain (feature - reference), within +-limit",
+       {{"feature", {"com_x", "com_z", "com_vx", "com_vz", "pitch", "pitch_rate"}}},
+       {"target"}},
   };
   return kinds;
 }
@@ -438,6 +442,13 @@ SkillFile load_skill_file(const std::string& path) {
         mr.fail(word, "expected one of " + quoted_list(list) + ", got \"" + value + "\"");
       }
       m.words[word] = value;
+    }
+    // Settings that name joint groups (a selector, as a target set's keys): bound to the
+    // character's groups with the skill.
+    for (const char* word : kind->selectors) {
+      if (!mr.has(word)) mr.fail(word, "expected a setting of the \"" + m.kind + "\" module (missing)");
+      m.words[word] = mr.string(word);
+      if (m.words[word].empty()) mr.fail(word, "expected a joint group, role or ROLE.plane (a selector), got \"\"");
     }
     for (const auto& [k, node] : *modules[i]) {
       const std::string key(k.str());
@@ -827,11 +838,32 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
   for (size_t p = 0; p < skill.phases.size(); ++p) {
     for (const std::string& mod : skill.phases[p].modules) b.phases[p].modules.push_back(skill.module_index(mod));
   }
+  // Joint groups the modules name.
+  for (const SkillModuleSpec& mod : skill.modules) {
+    const SkillModuleKind* kind = nullptr;
+    for (const SkillModuleKind& x : skill_module_kinds())
+      if (mod.kind == x.kind) kind = &x;
+    for (const char* word : kind->selectors) {
+      const std::string& selector = mod.words.at(word);
+      if (selector == "other" || selector == "root") {
+        fail(mod.line, "modules." + mod.name + "." + word, "expected a joint group, role or ROLE.plane, got \"" + selector + "\" (a target set's word, not a selector here)");
+      }
+      if (select_groups(selector, body).empty()) {
+        fail(mod.line, "modules." + mod.name + "." + word,
+             "expected a joint group, role or ROLE.plane of " + who + ", got \"" + selector + "\" (it selects no group)");
+      }
+    }
+  }
   // Feet by role need a swing leg.
   for (const SkillPhase& phase : skill.phases) {
     for (const SkillTransition& tr : phase.next) {
       for (const SkillCondition& c : tr.on) {
         if (c.kind == "contact_made" && c.foot == "swing") b.phases[static_cast<size_t>(skill.phase_index(phase.name))].swing_lands = true;
+        if (c.type == SkillCondition::Type::kTurned && body.root == RootKind::kFree) {
+          fail(tr.line, "phases." + phase.name + ".next.on",
+               "expected a planar root for on = \"turned\" (the root's pitch coordinate), but " + who +
+                   " has a free root: use on = \"feature\", feature = \"pitch\"");
+        }
         if ((c.foot == "swing" || c.foot == "stance") && phase.swing < 0) {
           fail(tr.line, "phases." + phase.name + ".next.foot", "expected a phase with a swing leg (swing = \"left\" or \"right\") for foot = \"" + c.foot + "\"");
         }

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "character/character.h"
+#include "control/skill_feature.h"
 #include "params/parameters.h"
 
 namespace diverse {
@@ -100,7 +101,7 @@ struct SkillCondition {
   // is read: no string is compared in a step).
   enum class Type { kDuration, kTime, kContact, kLiftoff, kContactMade, kContactLost, kPeak, kTurned, kSpotted, kFeature };
   Type type = Type::kDuration;
-  enum class Feature { kComX, kComZ, kComVx, kComVz, kPitch, kPitchRate };
+  using Feature = SkillFeature;
   Feature which = Feature::kComX;
   double threshold = 0;
 };
@@ -170,6 +171,8 @@ struct SkillModuleKind {
   const char* what;  // one line, for `diverse skill show` and messages
   // Settings that take one of a few words: {setting, {word, ...}} (required).
   std::vector<std::pair<const char*, std::vector<const char*>>> words = {};
+  // Settings that name joint groups, as a target set's selectors (required).
+  std::vector<const char*> selectors = {};
 };
 const std::vector<SkillModuleKind>& skill_module_kinds();
 

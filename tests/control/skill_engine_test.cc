@@ -18,42 +18,9 @@
 namespace diverse {
 namespace {
 
-// A skill for the tiny biped: the targets sets and gains every test shares, then `rest`
-// (modules and phases).
-std::string skill(const std::string& rest) {
-  return R"(name = "tiny"
-root = "planar"
-pairs = ["hip", "knee", "ankle"]
-[targets.stand]
-hip = { value = 0.0, world = "parent" }
-ankle = { value = 0.0, world = "child" }
-other = 0.0
-[targets.crouch]
-hip = { value = -0.3, world = "parent" }
-ankle = { value = 0.0, world = "child" }
-knee = -1.4
-other = 0.0
-[targets.push]
-hip = { value = 0.0, world = "parent" }
-ankle = { value = 0.5, world = "child" }
-knee = 0.0
-other = 0.0
-[targets.tuck]
-hip = 1.0
-knee = -1.2
-other = 0.0
-[gains.stiff]
-hip = { kp = 1500.0, kd = 40.0 }
-knee = { kp = 1500.0, kd = 40.0 }
-ankle = { kp = 600.0, kd = 20.0 }
-[[modules]]
-name = "balance"
-kind = "balance"
-kp = 1000.0
-kd = 200.0
-max_force = 200.0
-)" + rest;
-}
+// A skill for the tiny biped: the target sets and gains every test shares, then `rest`
+// (modules and phases): tests/control/tiny_biped.h.
+std::string skill(const std::string& rest) { return tiny_biped::skill(rest); }
 
 struct Rollout {
   Evaluation e;

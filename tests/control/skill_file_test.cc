@@ -104,7 +104,7 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
       {"unknown_kind", "kind = \"foot_placement\"", "kind = \"foot_planting\"", "foot_planting",
        "modules[1].kind: expected one of \"balance\", \"foot_placement\", \"spotting\", \"stance\", \"simbicon\", "
        "\"gravity_compensation\", \"stance_support\", \"stance_hip\", \"stance3d\", \"aim_legs\", \"root_damping\", "
-       "got \"foot_planting\"",
+       "\"linear_feedback\", got \"foot_planting\"",
        false},
       {"unknown_condition", "on = \"peak\"", "on = \"apex\"", "apex",
        "phases[3].next[1].on: expected one of \"duration\", \"time\", \"contact\", \"touchdown\", \"liftoff\", "
@@ -113,6 +113,23 @@ TEST(SkillFile, BadFilesNameTheFileLineFieldAndExpectation) {
       {"condition_setting", "{ to = \"land\", on = \"time\", after = 0.8, gave_up = true }",
        "{ to = \"land\", on = \"time\", gave_up = true }", "gave_up = true }",
        "phases[2].next[1].after: expected a setting for the \"time\" condition (missing)", false},
+      {"feedback_feature", "[[phases]]",
+       "[[modules]]\nname = \"fb\"\nkind = \"linear_feedback\"\nfeature = \"com_vy\"\ntarget = \"hip\"\ngain = 0.1\n\n[[phases]]",
+       "com_vy",
+       "modules[2].feature: expected one of \"com_x\", \"com_z\", \"com_vx\", \"com_vz\", \"pitch\", \"pitch_rate\", got \"com_vy\"",
+       false},
+      {"feedback_no_target", "[[phases]]",
+       "[[modules]]\nname = \"fb\"\nkind = \"linear_feedback\"\nfeature = \"com_vx\"\ngain = 0.1\n\n[[phases]]",
+       "[[modules]]\nname = \"fb\"", "modules[2].target: expected a setting of the \"linear_feedback\" module (missing)", false},
+      {"feedback_target", "[[phases]]",
+       "[[modules]]\nname = \"fb\"\nkind = \"linear_feedback\"\nfeature = \"com_vx\"\ntarget = \"tail\"\ngain = 0.1\n\n[[phases]]",
+       "[[modules]]\nname = \"fb\"",
+       "modules.fb.target: expected a joint group, role or ROLE.plane of the character " + human.body().spec->file +
+           ", got \"tail\" (it selects no group)",
+       true},
+      {"feedback_limit", "[[phases]]",
+       "[[modules]]\nname = \"fb\"\nkind = \"linear_feedback\"\nfeature = \"com_vx\"\ntarget = \"hip\"\ngain = 0.1\nlimit = 0.0\n\n[[phases]]",
+       "limit = 0.0", "modules[2].limit: expected a number in [1e-06, 1e+09], got 0", false},
       {"unknown_module", "modules = [\"landing\"]", "modules = [\"landing_aim\"]", "landing_aim",
        "phases[4].modules: expected modules the file declares in [[modules]], got \"landing_aim\"", false},
   };

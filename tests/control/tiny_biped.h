@@ -131,6 +131,44 @@ inline std::string write_skill(const std::string& name, const std::string& skill
   return path;
 }
 
+// A skill for the tiny biped: the target sets (stand, crouch, push, tuck), the gain set
+// `stiff` and a J^T balance module `balance` the engine's tests share, then `rest`
+// (modules and phases).
+inline std::string skill(const std::string& rest) {
+  return R"(name = "tiny"
+root = "planar"
+pairs = ["hip", "knee", "ankle"]
+[targets.stand]
+hip = { value = 0.0, world = "parent" }
+ankle = { value = 0.0, world = "child" }
+other = 0.0
+[targets.crouch]
+hip = { value = -0.3, world = "parent" }
+ankle = { value = 0.0, world = "child" }
+knee = -1.4
+other = 0.0
+[targets.push]
+hip = { value = 0.0, world = "parent" }
+ankle = { value = 0.5, world = "child" }
+knee = 0.0
+other = 0.0
+[targets.tuck]
+hip = 1.0
+knee = -1.2
+other = 0.0
+[gains.stiff]
+hip = { kp = 1500.0, kd = 40.0 }
+knee = { kp = 1500.0, kd = 40.0 }
+ankle = { kp = 600.0, kd = 20.0 }
+[[modules]]
+name = "balance"
+kind = "balance"
+kp = 1000.0
+kd = 200.0
+max_force = 200.0
+)" + rest;
+}
+
 // A task of the tiny biped under the skill `skill` (the text of a skill file): no landing
 // box, no constraint terms but falls.
 inline Task task(const std::string& name, const std::string& skill, const std::string& controller_extra = "") {
