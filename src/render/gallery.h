@@ -7,36 +7,20 @@
 // the others (summary.json, every motion metric); and, per variation, a slider along its
 // optimization path (paper figure 6a).
 //
-// What goes into the page, as JSON (gallery_data):
+// What the page shows is gathered from the run by finished/gallery_data.h
+// (collect_gallery_data: figures, distances, path points simulated, progress, shapes,
+// robustness, blends, poses); here it becomes the page's JSON (gallery_json):
 //   - per model: its bodies and geoms (type, size, body, position and quaternion in the
-//     body frame, colour); the world body's geoms (boxes, obstacles) are the scene;
-//   - per motion: the world position and orientation (xpos, xquat from mj_kinematics) of
-//     every body, sampled at `fps` from the recorded states; numbers are rounded to 4
+//     body frame, colour); the world body's geoms (boxes, obstacles) are the scene; models
+//     the same in every number are listed once;
+//   - per motion, path point and blend: the world position and orientation (xpos, xquat
+//     from mj_kinematics) of every body at each of its poses; numbers are rounded to 4
 //     decimals (0.1 mm, 1e-4 of a unit quaternion), which keeps a run of 5 motions and 4
 //     paths at a few megabytes;
-//   - per variation i, points of its optimization path at 0, 25, 50, 75 and 100 % of the
-//     path's distance from M0. The path runs from M0 through the means CMA-ES took for
-//     variation i (paths/m<i>.json) to the variation's result (motions/m<i>.json). Paper
-//     figure 6a parameterizes it by the metric distance of each point's motion from M0, so
-//     the path's points are simulated when the gallery is made (TaskEvaluator on the run's
-//     task file, each point on its own body when the run varied the shape; at most
-//     `max_path_candidates` of them, evenly spaced, to measure distances), and the point
-//     nearest to each fraction of the result's distance is simulated again with
-//     recording on. Points that miss the task (C > 0) are marked.
-//   - the run's progress for the plots panel, from log.jsonl: per generation (the last CMA
-//     step of each), D of the current set, D of the best set so far, and every motion's
-//     constraint value C and dmin; at most max_progress_points generations, thinned evenly;
-//   - for a run whose bodies varied, every motion's link-length scales (summary.json);
-//   - every motion's foot slip (summary.json, task/foot_slip.h), for runs that have it;
-//   - every motion's shares of the robustness suite (robust/robustness.h), over all and
-//     by kind, from RUN/robustness.json, or from summary.json "robustness" without it;
-//     null (and a note) for a run with neither, made before every run ended with the
-//     suite: the page says the suite was not run;
-//   - the run's blends, when `diverse blend RUN` made them (run/blend.h, RUN/blend/): per
-//     blend its weights on M0..MN, C, whether it meets the task, its distances to the
-//     motions and its frames (from its motion file), and the share that meets the task,
-//     against the path points'. Blends made from an earlier run in the same directory
-//     (another run_fingerprint) are left out with a note.
+//   - how the page first looks at the motions (render/view_plan.h), as the film strip
+//     does, and the task's landing region on the floor (render/run_media.h);
+//   - the rest as collected: figures, distances, progress, shapes, robustness (null and a
+//     note for a run without the suite: the page says the suite was not run), blends.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -47,18 +31,14 @@
 #include <string>
 #include <vector>
 
+#include "finished/gallery_data.h"
 #include "finished/run_view.h"
+#include "render/offscreen.h"
 
 namespace diverse {
 
-struct GalleryOptions {
-  double fps = 30.0;              // body poses per second of motion
-  bool paths = true;              // simulate optimization path points (needs the task file)
-  std::vector<double> path_fractions{0.0, 0.25, 0.5, 0.75, 1.0};
-  int max_path_candidates = 64;   // path points per variation simulated to measure distances
-  bool blends = true;             // the run's blends (RUN/blend/), if it has any
-  int max_progress_points = 400;  // generations of log.jsonl kept for the plots (thinned evenly)
-  int threads = 0;                // simulation threads; 0 = one per core
+// What to collect (finished/gallery_data.h) and the page template.
+struct GalleryOptions : GalleryDataOptions {
   std::filesystem::path page_template;  // "" = gallery_template_path()
 };
 
@@ -68,23 +48,16 @@ struct GalleryOptions {
 // (node and npm, or `npm ci` in web/) if it does not exist.
 std::filesystem::path gallery_template_path();
 
-// Indices of the path points nearest to each fraction of the path's distance from M0.
-// `distances[k]` is point k's distance from M0 (NaN if unknown: a failed simulation);
-// the last point is the path's end. Point 0 answers fraction 0 and the last point
-// fraction 1 when their distances are 0 and the end's; ties go to the point nearest in
-// index to fraction * (points - 1). If the end is no farther than the start (distance 0
-// or unknown), points are picked by index instead. Throws std::invalid_argument if
-// `distances` is empty.
-std::vector<int> pick_path_points(std::span<const double> distances,
-                                  std::span<const double> fractions);
-
 // The model's bodies and geoms, as the page draws them (see above).
 nlohmann::json model_json(const mjModel* model);
 // Per frame, xpos (3) and xquat (4, w first) of bodies 1 .. nbody-1, rounded, flattened.
 nlohmann::json body_frames_json(const mjModel* model, std::span<const std::vector<double>> frames);
 
-// Everything the page shows (see above). Throws UserError if paths are asked for and the
-// task file is missing or changed since the run, or a path file is missing or malformed.
+// The page's data (see above) from what was collected and the ground strips to draw.
+nlohmann::json gallery_json(const GalleryData& data, std::span<const GroundStrip> strips);
+
+// gallery_json of the run's collected data and its landing region; throws as
+// collect_gallery_data does.
 nlohmann::json gallery_data(const RunView& run, const GalleryOptions& options = {});
 
 // The template with the data put in its place (JSON inside a <script> element, with "</"
