@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,21 +32,36 @@ class GalleryDataTest : public ::testing::Test {
     const cli_test::CliResult blend =
         cli_test::run_cli("blend " + dir_.string() + " --samples 3 --path-points 2 --threads 2");
     ASSERT_EQ(blend.status, 0) << blend.output;
+    run_ = std::make_unique<RunView>(load_run_view(dir_));
+    summary_ = read_json(dir_ / "summary.json");
+    GalleryDataOptions options;
+    options.threads = 2;
+    data_ = std::make_unique<GalleryData>(collect_gallery_data(*run_, options));
   }
 
-  static void TearDownTestSuite() { fs::remove_all(dir_.parent_path()); }
+  void SetUp() override { ASSERT_NE(data_, nullptr) << "the run or its blends could not be made"; }
+
+  static void TearDownTestSuite() {
+    data_.reset();
+    run_.reset();
+    fs::remove_all(dir_.parent_path());
+  }
 
   static fs::path dir_;
+  static std::unique_ptr<RunView> run_;
+  static nlohmann::json summary_;
+  static std::unique_ptr<GalleryData> data_;  // everything, with the default options
 };
 fs::path GalleryDataTest::dir_;
+std::unique_ptr<RunView> GalleryDataTest::run_;
+nlohmann::json GalleryDataTest::summary_;
+std::unique_ptr<GalleryData> GalleryDataTest::data_;
 
 // Every motion's figures are the summary's, finite; its poses are its recorded states.
 TEST_F(GalleryDataTest, MotionsHaveTheSummarysFiguresAndTheirRecordedPoses) {
-  const RunView run = load_run_view(dir_);
-  const nlohmann::json summary = read_json(dir_ / "summary.json");
-  GalleryDataOptions options;
-  options.threads = 2;
-  const GalleryData data = collect_gallery_data(run, options);
+  const RunView& run = *run_;
+  const nlohmann::json& summary = summary_;
+  const GalleryData& data = *data_;
 
   EXPECT_EQ(data.task, "jump_high");
   EXPECT_EQ(data.metric, summary["metric"]);
@@ -96,8 +112,8 @@ TEST_F(GalleryDataTest, ProgressAndRobustnessAreTheRunsFiles) {
   GalleryDataOptions options;
   options.paths = false;
   options.blends = false;
-  const GalleryData data = collect_gallery_data(load_run_view(dir_), options);
-  const nlohmann::json summary = read_json(dir_ / "summary.json");
+  const GalleryData data = collect_gallery_data(*run_, options);
+  const nlohmann::json& summary = summary_;
   ASSERT_TRUE(data.progress.has_value());
   EXPECT_EQ(data.progress->generations_total, 2u);
   EXPECT_EQ(data.progress->generation, (std::vector<long long>{1, 2}));
@@ -138,11 +154,10 @@ TEST_F(GalleryDataTest, ProgressAndRobustnessAreTheRunsFiles) {
 // Each variation's path: its points simulated, the last the recorded result at the
 // summary's distance from M0; and the run's blends as blend/summary.json lists them.
 TEST_F(GalleryDataTest, PathsEndAtTheResultAndBlendsAreTheBlendFiles) {
-  const RunView run = load_run_view(dir_);
-  const nlohmann::json summary = read_json(dir_ / "summary.json");
-  GalleryDataOptions options;
-  options.threads = 2;
-  const GalleryData data = collect_gallery_data(run, options);
+  const RunView& run = *run_;
+  const nlohmann::json& summary = summary_;
+  const GalleryData& data = *data_;
+  const GalleryDataOptions options;
 
   ASSERT_EQ(data.paths.size(), 2u);
   for (std::size_t v = 1; v <= 2; ++v) {
