@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The skills added by files alone (skills/hop.toml, skills/split_leap.toml,
-# skills/tuck_jump.toml on the tailwalker, skills/star_jump.toml on the 3D human), end to
-# end at a small budget:
+# skills/tuck_jump.toml on the tailwalker, skills/star_jump.toml on the 3D human,
+# skills/robot_tuck_hop.toml on the bird robot), end to end at a small budget:
 #
 #   new_skills_e2e.sh DIVERSE_BINARY SOURCE_DIR [TASK ...]
 #
@@ -16,7 +16,7 @@ diverse="$1"
 src="$2"
 shift 2
 tasks=("$@")
-[ "${#tasks[@]}" -gt 0 ] || tasks=(hop split_leap tailwalker_tuck_jump star_jump)
+[ "${#tasks[@]}" -gt 0 ] || tasks=(hop split_leap tailwalker_tuck_jump star_jump robot_tuck_hop)
 
 if [ -n "${E2E_KEEP:-}" ]; then
   work="$E2E_KEEP"
