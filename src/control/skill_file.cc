@@ -336,6 +336,23 @@ void check_setting(const TomlReader& r, const std::string& key, double v) {
 
 }  // namespace
 
+namespace {
+
+// The features a linear_feedback module may read: skill_feature_names(), as words.
+std::vector<const char*> feature_words() {
+  std::vector<const char*> words;
+  for (const std::string& name : skill_feature_names()) words.push_back(name.c_str());  // static strings
+  return words;
+}
+
+}  // namespace
+
+const SkillModuleKind* find_module_kind(const std::string& kind) {
+  for (const SkillModuleKind& k : skill_module_kinds())
+    if (kind == k.kind) return &k;
+  return nullptr;
+}
+
 const std::vector<SkillModuleKind>& skill_module_kinds() {
   static const std::vector<SkillModuleKind> kinds = {
       {"balance", {"kp", "kd", "max_force"}, {"gravity_compensation", "offset", "lean"},
@@ -363,7 +380,7 @@ const std::vector<SkillModuleKind>& skill_module_kinds() {
        "push-off turn damping: the hip hinges damp the root's rotation about their axes"},
       {"linear_feedback", {"gain"}, {"reference", "limit", "sample"},
        "linear feedback: the targets of `target`'s joints offset by gain (feature - reference), within +-limit",
-       {{"feature", {"com_x", "com_z", "com_vx", "com_vz", "pitch", "pitch_rate"}}},
+       {{"feature", feature_words()}},
        {"target"}},
   };
   return kinds;
@@ -577,9 +594,7 @@ void override_skill_settings(SkillFile& skill, const TomlReader& r, const std::v
     for (const auto& [sk, sn] : *node.as_table()) {
       const std::string setting(sk.str());
       auto it = spec.settings.find(setting);
-      const SkillModuleKind* kind = nullptr;
-      for (const SkillModuleKind& x : skill_module_kinds())
-        if (spec.kind == x.kind) kind = &x;
+      const SkillModuleKind* kind = find_module_kind(spec.kind);
       const bool known = std::any_of(kind->required.begin(), kind->required.end(), [&](const char* x) { return setting == x; }) ||
                          std::any_of(kind->optional.begin(), kind->optional.end(), [&](const char* x) { return setting == x; });
       if (!known) mr.fail(setting, "expected a setting of the \"" + spec.kind + "\" module " + key);
@@ -840,10 +855,7 @@ SkillBinding bind_skill(const SkillFile& skill, const Character& body, const mjM
   }
   // Joint groups the modules name.
   for (const SkillModuleSpec& mod : skill.modules) {
-    const SkillModuleKind* kind = nullptr;
-    for (const SkillModuleKind& x : skill_module_kinds())
-      if (mod.kind == x.kind) kind = &x;
-    for (const char* word : kind->selectors) {
+    for (const char* word : find_module_kind(mod.kind)->selectors) {
       const std::string& selector = mod.words.at(word);
       if (selector == "other" || selector == "root") {
         fail(mod.line, "modules." + mod.name + "." + word, "expected a joint group, role or ROLE.plane, got \"" + selector + "\" (a target set's word, not a selector here)");

@@ -175,6 +175,8 @@ struct SkillModuleKind {
   std::vector<const char*> selectors = {};
 };
 const std::vector<SkillModuleKind>& skill_module_kinds();
+// The kind called `kind`, or null.
+const SkillModuleKind* find_module_kind(const std::string& kind);
 
 // Parses and checks a skill file. Throws UserError.
 SkillFile load_skill_file(const std::string& path);
